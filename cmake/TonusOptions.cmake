@@ -1,0 +1,36 @@
+# Project-wide options, warning sets and the freestanding target property.
+
+option(TONUS_TARGET_ARM "Cross build for the Cortex-M4F band (set by the arm preset)" OFF)
+option(TONUS_FUZZ "Build the libFuzzer targets (clang only, set by the fuzz preset)" OFF)
+option(TONUS_WERROR "Treat warnings as errors" ON)
+
+# Warnings for every target of ours; third-party headers come in as SYSTEM.
+add_library(tonus_warnings INTERFACE)
+target_compile_options(tonus_warnings INTERFACE
+  -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wsign-conversion
+  -Wcast-align -Wnon-virtual-dtor -Wold-style-cast -Woverloaded-virtual
+  -Wnull-dereference -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough
+  $<$<BOOL:${TONUS_WERROR}>:-Werror>)
+
+# Freestanding subset for code that runs on the band: no exceptions, no RTTI,
+# no thread-safe static guards (they pull in __cxa_guard_* and may lock).
+# The heap ban is enforced at link time by tonus_poison_heap() below.
+function(tonus_freestanding target)
+  target_compile_options(${target} PRIVATE
+    -fno-exceptions -fno-rtti -fno-threadsafe-statics -fno-asynchronous-unwind-tables)
+  set_property(TARGET ${target} PROPERTY TONUS_FREESTANDING ON)
+endfunction()
+
+# Link-time heap poison: every allocation entry point is redirected with
+# --wrap to a symbol that is never defined, so any object file of ours that
+# references malloc/new/exceptions fails to link.
+set(TONUS_HEAP_SYMBOLS
+  malloc calloc realloc free aligned_alloc posix_memalign memalign
+  _Znwm _Znam _ZnwmRKSt9nothrow_t _ZnamRKSt9nothrow_t
+  _ZnwmSt11align_val_t _ZnamSt11align_val_t
+  __cxa_allocate_exception __cxa_throw)
+function(tonus_poison_heap target)
+  foreach(sym IN LISTS TONUS_HEAP_SYMBOLS)
+    target_link_options(${target} PRIVATE "LINKER:--wrap=${sym}")
+  endforeach()
+endfunction()
