@@ -1,0 +1,156 @@
+// CAN binding: classic CAN 2.0A (11-bit ids, <= 8 data bytes).
+//
+// ID plan: id = function base | node id (0..31). Lower ids win arbitration,
+// so the stream outranks commands, which outrank the heartbeat.
+//   0x100 STATUS     seq u16, device_time_us u32, status u16       (opens a cycle)
+//   0x120 LEVELS0    levels of groups 0..3, u16 each
+//   0x140 LEVELS1    levels of groups 4..5
+//   0x160..0x1C0 ENV0..ENV3  envelopes of channels 4k..4k+3 (every Nth cycle)
+//   0x1E0 FLAGS      electrode_off u16, saturation u16, artifact u16,
+//                    counts u8 (group_count-1 << 4 | channel_count-1),
+//                    sequence low byte u8                          (closes a cycle)
+//   0x580 RESPONSE   segmented response message (device -> host)
+//   0x600 REQUEST    segmented request message (host -> device)
+//   0x700 HEARTBEAT  state u8, protocol version u8, status u16, uptime_ms u32
+// A stream cycle is sent in that order; the host assembles it in StreamAssembler.
+// The sequence low byte in FLAGS ties it to its STATUS, so that frames of two
+// cycles never merge into one message when closing or opening frames are lost.
+// Command messages (<= 63 bytes) are split in segments of 7 bytes after a
+// header byte: high nibble = segment count (1..9), low nibble = index.
+// protocol/tonus.dbc describes every frame for node 1.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "tonus/protocol/error.hpp"
+#include "tonus/protocol/limits.hpp"
+#include "tonus/protocol/stream.hpp"
+
+namespace tonus::proto {
+
+// Transport-neutral classic CAN frame (the host maps it to SocketCAN's struct can_frame).
+struct CanFrame {
+  static constexpr std::uint8_t kExtended = 1U << 0U;  // 29-bit id
+  static constexpr std::uint8_t kRemote = 1U << 1U;    // RTR frame
+  static constexpr std::uint8_t kErrorFrame = 1U << 2U;
+  std::uint32_t id = 0;
+  std::uint8_t dlc = 0;  // 0..8
+  std::uint8_t flags = 0;
+  std::array<std::uint8_t, 8> data{};
+
+  [[nodiscard]] std::span<const std::uint8_t> payload() const { return {data.data(), dlc}; }
+  friend bool operator==(const CanFrame&, const CanFrame&) = default;
+};
+
+namespace can {
+
+inline constexpr std::uint8_t kMaxNodeId = 31;
+inline constexpr std::uint32_t kNodeMask = 0x1F;
+
+enum class Function : std::uint16_t {
+  status = 0x100,
+  levels0 = 0x120,
+  levels1 = 0x140,
+  envelope0 = 0x160,
+  envelope1 = 0x180,
+  envelope2 = 0x1A0,
+  envelope3 = 0x1C0,
+  flags = 0x1E0,
+  response = 0x580,
+  request = 0x600,
+  heartbeat = 0x700,
+};
+
+constexpr std::uint32_t make_id(Function f, std::uint8_t node) {
+  return static_cast<std::uint32_t>(f) | (node & kNodeMask);
+}
+
+// Splits a standard id into function and node; false for ids outside the plan.
+bool split_id(std::uint32_t id, Function& f, std::uint8_t& node);
+
+inline constexpr std::size_t kGroupsPerFrame = 4;
+inline constexpr std::size_t kChannelsPerFrame = 4;
+inline constexpr std::size_t kMaxStreamFrames = 8;  // status + 2 levels + 4 envelope + flags
+
+// Frames of one stream cycle, in send order. Envelope frames are included only
+// when `with_envelopes` (the device sends them every can_envelope_divider cycles).
+Error encode_stream(const StreamMessage& msg, std::uint8_t node, bool with_envelopes,
+                    std::span<CanFrame> out, std::size_t& count);
+
+// Reassembles stream cycles of one node. Frames of other nodes are ignored.
+// A cycle is delivered when its FLAGS frame arrives and every levels frame the
+// counts call for was seen; envelopes missing from a cycle keep their previous
+// values (envelopes_fresh() says whether this cycle carried them).
+class StreamAssembler {
+ public:
+  explicit StreamAssembler(std::uint8_t node) : node_(node) {}
+
+  // Returns Error::ok and sets `complete` when `message()` holds a new cycle.
+  // Malformed frames return an error and void the cycle in progress.
+  Error push(const CanFrame& frame, bool& complete);
+
+  [[nodiscard]] const StreamMessage& message() const { return msg_; }
+  [[nodiscard]] bool envelopes_fresh() const { return envelopes_fresh_; }
+  [[nodiscard]] std::uint32_t incomplete_cycles() const { return incomplete_cycles_; }
+  [[nodiscard]] std::uint32_t stray_frames() const { return stray_frames_; }
+
+ private:
+  void abandon_cycle();
+
+  std::uint8_t node_;
+  bool in_cycle_ = false;
+  std::uint8_t seen_ = 0;  // bit per stream function index (levels0.. envelope3)
+  std::array<std::uint8_t, 6> dlc_{};
+  StreamMessage pending_{};
+  StreamMessage msg_{};
+  bool envelopes_fresh_ = false;
+  std::uint32_t incomplete_cycles_ = 0;
+  std::uint32_t stray_frames_ = 0;
+};
+
+enum class NodeState : std::uint8_t { booting = 0, running = 1, calibrating = 2, fault = 3 };
+
+struct Heartbeat {
+  NodeState state = NodeState::running;
+  std::uint8_t protocol_version = kProtocolVersion;
+  std::uint16_t status = 0;  // status_bit::*
+  std::uint32_t uptime_ms = 0;
+  friend bool operator==(const Heartbeat&, const Heartbeat&) = default;
+};
+
+CanFrame encode_heartbeat(const Heartbeat& hb, std::uint8_t node);
+Error decode_heartbeat(const CanFrame& frame, Heartbeat& out);
+
+// Segmentation of a command request/response message (bytes as produced by
+// encode_request / encode_response) into REQUEST or RESPONSE frames.
+inline constexpr std::size_t kSegmentData = 7;
+inline constexpr std::size_t kMaxSegments = (kMaxMessageSize + kSegmentData - 1) / kSegmentData;  // 9
+
+Error segment(std::span<const std::uint8_t> message, Function f, std::uint8_t node,
+              std::span<CanFrame> out, std::size_t& count);
+
+// Collects the segments of one function/node. A new index-0 segment restarts;
+// a gap, duplicate or count change voids the message (Error::out_of_order).
+// The message's own length and CRC are checked by the command decoder.
+class Reassembler {
+ public:
+  Reassembler(Function f, std::uint8_t node) : function_(f), node_(node) {}
+
+  Error push(const CanFrame& frame, bool& complete);
+  [[nodiscard]] std::span<const std::uint8_t> message() const { return {buffer_.data(), size_}; }
+  void reset();
+
+ private:
+  Function function_;
+  std::uint8_t node_;
+  std::uint8_t total_ = 0;
+  std::uint8_t expected_ = 0;
+  std::size_t size_ = 0;
+  std::array<std::uint8_t, kMaxSegments * kSegmentData> buffer_{};
+};
+
+}  // namespace can
+}  // namespace tonus::proto
