@@ -83,14 +83,14 @@ Error encode_stream(const StreamMessage& msg, std::uint8_t node, bool with_envel
 
   for (std::size_t k = 0; k < level_frames; ++k) {
     CanFrame fr = frame_for(data_function(k), node);
-    put_values(fr, std::span(msg.levels).subspan(k * kGroupsPerFrame,
-                                                 values_in_frame(msg.group_count, kGroupsPerFrame, k)));
+    put_values(
+        fr, std::span(msg.levels).subspan(k * kGroupsPerFrame, values_in_frame(msg.group_count, kGroupsPerFrame, k)));
     out[n++] = fr;
   }
   for (std::size_t k = 0; k < env_frames; ++k) {
     CanFrame fr = frame_for(data_function(kLevelFrames + k), node);
-    put_values(fr, std::span(msg.envelopes).subspan(k * kChannelsPerFrame,
-                                                    values_in_frame(msg.channel_count, kChannelsPerFrame, k)));
+    put_values(fr, std::span(msg.envelopes)
+                       .subspan(k * kChannelsPerFrame, values_in_frame(msg.channel_count, kChannelsPerFrame, k)));
     out[n++] = fr;
   }
 
@@ -200,8 +200,7 @@ Error StreamAssembler::push(const CanFrame& frame, bool& complete) {
       for (std::size_t k = 0; k < kLevelFrames; ++k) {
         const bool expected = k < level_frames;
         const bool got = (seen >> k) & 1U;
-        if (expected != got ||
-            (got && dlc_[k] != 2 * values_in_frame(pending_.group_count, kGroupsPerFrame, k))) {
+        if (expected != got || (got && dlc_[k] != 2 * values_in_frame(pending_.group_count, kGroupsPerFrame, k))) {
           ++incomplete_cycles_;
           return Error::out_of_order;
         }
@@ -214,8 +213,7 @@ Error StreamAssembler::push(const CanFrame& frame, bool& complete) {
           const bool expected = k < env_frames;
           const bool got = (env_seen >> k) & 1U;
           if (expected != got ||
-              (got && dlc_[kLevelFrames + k] !=
-                          2 * values_in_frame(pending_.channel_count, kChannelsPerFrame, k))) {
+              (got && dlc_[kLevelFrames + k] != 2 * values_in_frame(pending_.channel_count, kChannelsPerFrame, k))) {
             ++incomplete_cycles_;
             return Error::out_of_order;
           }
@@ -232,8 +230,7 @@ Error StreamAssembler::push(const CanFrame& frame, bool& complete) {
     }
     case Function::response:
     case Function::request:
-    case Function::heartbeat:
-      return Error::ok;
+    case Function::heartbeat: return Error::ok;
   }
   return Error::ok;
 }

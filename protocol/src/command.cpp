@@ -16,8 +16,7 @@ bool is_known(Opcode op) {
     case Opcode::get_config:
     case Opcode::set_config:
     case Opcode::save_config:
-    case Opcode::reset:
-      return true;
+    case Opcode::reset: return true;
   }
   return false;
 }

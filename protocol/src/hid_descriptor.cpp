@@ -125,8 +125,7 @@ Error parse_report_descriptor(std::span<const std::uint8_t> desc, DescriptorInfo
       case ItemType::local:
         if (item_tag == tag::usage) last_usage = static_cast<std::uint16_t>(data);
         break;
-      case ItemType::reserved:
-        return Error::bad_type;
+      case ItemType::reserved: return Error::bad_type;
     }
   }
   if (depth != 0) return Error::truncated;  // unclosed collection

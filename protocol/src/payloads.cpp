@@ -166,8 +166,7 @@ Error DeviceConfig::read(ByteReader& r) {
   lowpass_dhz = r.u16();
   notch_hz = r.u8();
   notch_harmonics = r.u8();
-  if (Error e = read_enum(r, envelope_mode, raw(EnvelopeMode::linear), raw(EnvelopeMode::moving_rms));
-      e != Error::ok) {
+  if (Error e = read_enum(r, envelope_mode, raw(EnvelopeMode::linear), raw(EnvelopeMode::moving_rms)); e != Error::ok) {
     return e;
   }
   envelope_tau_ms = r.u16();

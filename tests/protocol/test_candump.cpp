@@ -1,12 +1,12 @@
 #include <doctest/doctest.h>
 
+#include <unistd.h>
 #include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 
 #include "tonus/protocol/candump.hpp"
 
@@ -80,19 +80,19 @@ TEST_CASE("candump parser accepts what can-utils writes") {
 TEST_CASE("candump parser rejects malformed lines") {
   const char* bad[] = {
       "",
-      "1436509052.249713 vcan0 044#00",      // no parentheses
-      "(1436509052.24971) vcan0 044#00",     // 5-digit micros
-      "(1436509052.249713)vcan0 044#00",     // missing space
-      "(1436509052.249713) vcan0",           // no frame
-      "(1436509052.249713) vcan0 044",       // no '#'
-      "(1436509052.249713) vcan0 44#00",     // 2-digit id
-      "(1436509052.249713) vcan0 800#00",    // over 11 bits
-      "(1436509052.249713) vcan0 G44#00",    // not hex
-      "(1436509052.249713) vcan0 044#0",     // odd data length
+      "1436509052.249713 vcan0 044#00",                    // no parentheses
+      "(1436509052.24971) vcan0 044#00",                   // 5-digit micros
+      "(1436509052.249713)vcan0 044#00",                   // missing space
+      "(1436509052.249713) vcan0",                         // no frame
+      "(1436509052.249713) vcan0 044",                     // no '#'
+      "(1436509052.249713) vcan0 44#00",                   // 2-digit id
+      "(1436509052.249713) vcan0 800#00",                  // over 11 bits
+      "(1436509052.249713) vcan0 G44#00",                  // not hex
+      "(1436509052.249713) vcan0 044#0",                   // odd data length
       "(1436509052.249713) vcan0 044#000102030405060708",  // 9 bytes
-      "(1436509052.249713) vcan0 044#R9",    // remote dlc over 8
+      "(1436509052.249713) vcan0 044#R9",                  // remote dlc over 8
       "(1436509052.249713) averyveryverylongname 044#00",  // iface over 15
-      "(9999999999999.000000) vcan0 044#00", // seconds overflow guard
+      "(9999999999999.000000) vcan0 044#00",               // seconds overflow guard
   };
   for (const char* line : bad) {
     CAPTURE(line);

@@ -114,8 +114,14 @@ TEST_CASE("tonus.dbc describes the heartbeat and command segments") {
                           status_bit::calibrating | status_bit::config_dirty, 987654};
   const CanFrame f = can::encode_heartbeat(hb, kNode);
   check_frame(find(dbc, f.id), f,
-              {{"State", 2}, {"ProtocolVersion", kProtocolVersion}, {"Calibrated", 0}, {"Calibrating", 1},
-               {"WatchdogReset", 0}, {"ConfigDirty", 1}, {"BlockLost", 0}, {"Uptime", 987654}});
+              {{"State", 2},
+               {"ProtocolVersion", kProtocolVersion},
+               {"Calibrated", 0},
+               {"Calibrating", 1},
+               {"WatchdogReset", 0},
+               {"ConfigDirty", 1},
+               {"BlockLost", 0},
+               {"Uptime", 987654}});
 
   std::array<std::uint8_t, 20> message{};
   for (std::size_t i = 0; i < message.size(); ++i) message[i] = static_cast<std::uint8_t>(0xA0 + i);

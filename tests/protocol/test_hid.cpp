@@ -33,7 +33,7 @@ TEST_CASE("the report descriptor declares exactly the reports the codec sends") 
 TEST_CASE("descriptor parser totals bits per report and handles push/pop and long items") {
   // Two reports: id 5 input = 3 x 8 + 1 x 16 bits; feature id 6 = 2 x 4 bits (rounded up to 1 byte).
   const std::vector<std::uint8_t> desc = {
-      0x05, 0x01, 0x09, 0x02, 0xA1, 0x01,  // Usage Page (1), Usage (2), Collection (Application)
+      0x05, 0x01, 0x09, 0x02, 0xA1, 0x01,              // Usage Page (1), Usage (2), Collection (Application)
       0x85, 0x05, 0x75, 0x08, 0x95, 0x03, 0x81, 0x02,  // id 5: 3 x 8 input
       0xA4,                                            // Push
       0x75, 0x10, 0x95, 0x01, 0x81, 0x02,              // 1 x 16 input
@@ -51,15 +51,15 @@ TEST_CASE("descriptor parser totals bits per report and handles push/pop and lon
 
 TEST_CASE("descriptor parser rejects malformed descriptors") {
   const std::vector<std::vector<std::uint8_t>> bad = {
-      {0x06, 0x00},                                // truncated item data
-      {0xA1, 0x01},                                // unclosed collection
-      {0xC0},                                      // end without collection
-      {0xA1, 0x01, 0xB4, 0xC0},                    // pop without push
-      {0xA1, 0x01, 0x85, 0x00, 0xC0},              // report id 0 is reserved
-      {0x81, 0x02},                                // input outside a collection
-      {0xA1, 0x01, 0x0C, 0xC0},                    // reserved item type
-      {0xFE, 0x05, 0x00, 0x01},                    // long item longer than the data
-      {0xA1, 0x01, 0x77, 0xFF, 0xFF, 0xFF, 0xFF,   // report size 2^32-1 ...
+      {0x06, 0x00},                                      // truncated item data
+      {0xA1, 0x01},                                      // unclosed collection
+      {0xC0},                                            // end without collection
+      {0xA1, 0x01, 0xB4, 0xC0},                          // pop without push
+      {0xA1, 0x01, 0x85, 0x00, 0xC0},                    // report id 0 is reserved
+      {0x81, 0x02},                                      // input outside a collection
+      {0xA1, 0x01, 0x0C, 0xC0},                          // reserved item type
+      {0xFE, 0x05, 0x00, 0x01},                          // long item longer than the data
+      {0xA1, 0x01, 0x77, 0xFF, 0xFF, 0xFF, 0xFF,         // report size 2^32-1 ...
        0x97, 0xFF, 0xFF, 0xFF, 0xFF, 0x81, 0x02, 0xC0},  // ... times count 2^32-1
   };
   for (const auto& d : bad) {

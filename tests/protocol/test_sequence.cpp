@@ -39,9 +39,9 @@ TEST_CASE("messages older than the window are stale; large jumps resync") {
   CHECK(t.lost() == 99);
   CHECK(t.push(1000 + 1) == V::stale);  // 99 behind, window is 64
   CHECK(t.stale() == 1);
-  CHECK(t.push(40000) == V::resync);    // device restarted
+  CHECK(t.push(40000) == V::resync);  // device restarted
   CHECK(t.resyncs() == 1);
-  CHECK(t.lost() == 99);                // the jump is not loss
+  CHECK(t.lost() == 99);  // the jump is not loss
   CHECK(t.push(40001) == V::in_order);
 }
 

@@ -26,7 +26,8 @@ std::vector<DbcMessage> read_dbc(const std::string& path) {
   std::smatch m;
   for (std::string line; std::getline(in, line);) {
     if (std::regex_match(line, m, bo)) {
-      out.push_back(DbcMessage{static_cast<std::uint32_t>(std::stoul(m[1])), m[2], static_cast<unsigned>(std::stoul(m[3])), {}});
+      out.push_back(
+          DbcMessage{static_cast<std::uint32_t>(std::stoul(m[1])), m[2], static_cast<unsigned>(std::stoul(m[3])), {}});
     } else if (std::regex_match(line, m, sg)) {
       if (out.empty()) throw std::runtime_error("SG_ before any BO_ in " + path);
       DbcSignal s;

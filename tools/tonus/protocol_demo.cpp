@@ -241,9 +241,8 @@ CommandTally run_commands(std::uint8_t node) {
     hid::Report in{};
     Request hreq{};
     Response hrsp{};
-    if (hid::pack_request(ex.req, out) == Error::ok && hid::unpack_request(out, hreq) == Error::ok &&
-        hreq == ex.req && hid::pack_response(ex.rsp, in) == Error::ok &&
-        hid::unpack_response(in, hrsp) == Error::ok && hrsp == ex.rsp) {
+    if (hid::pack_request(ex.req, out) == Error::ok && hid::unpack_request(out, hreq) == Error::ok && hreq == ex.req &&
+        hid::pack_response(ex.rsp, in) == Error::ok && hid::unpack_response(in, hrsp) == Error::ok && hrsp == ex.rsp) {
       ++t.hid_ok;
     }
     // CAN: segmented request and response frames.
@@ -290,8 +289,8 @@ int run_protocol_demo(const DemoOptions& opt) {
     }
   }
 
-  fmt::print("tonus demo: {:.2f} s of simulated band stream at {} Hz (4 groups, 8 channels), seed {}\n",
-             opt.seconds, opt.report_rate_hz, opt.seed);
+  fmt::print("tonus demo: {:.2f} s of simulated band stream at {} Hz (4 groups, 8 channels), seed {}\n", opt.seconds,
+             opt.report_rate_hz, opt.seed);
   fmt::print("links drop {:.1f} %, duplicate {:.1f} %, reorder {:.1f} % of reports (CAN: drop per frame)\n\n",
              100 * opt.loss, 100 * opt.duplication, 100 * opt.reorder);
 
@@ -307,8 +306,8 @@ int run_protocol_demo(const DemoOptions& opt) {
   fmt::print("CAN stream (node {}, envelopes every {} cycles)\n", opt.can_node, opt.can_envelope_divider);
   fmt::print("  cycles sent {:>7}   frames {:>7}   frames dropped {:>5}\n", can.cycles, can.frames_sent,
              can.frames_dropped);
-  fmt::print("  cycles assembled {} (intact on the bus {}), exact {}, incomplete {}, stray frames {}\n",
-             can.complete, can.expect_complete, can.complete - can.mismatches, can.incomplete, can.stray);
+  fmt::print("  cycles assembled {} (intact on the bus {}), exact {}, incomplete {}, stray frames {}\n", can.complete,
+             can.expect_complete, can.complete - can.mismatches, can.incomplete, can.stray);
   fmt::print("  host counted lost cycles {} (expected {})\n", can.lost, can.expect_lost);
   fmt::print("Commands (request + response, both bindings)\n");
   fmt::print("  exchanges {}   HID round trips ok {}   CAN segmented round trips ok {}\n", cmd.exchanges, cmd.hid_ok,
@@ -317,9 +316,9 @@ int run_protocol_demo(const DemoOptions& opt) {
 
   bool ok = true;
   ok &= check(hid.mismatches == 0 && hid.decode_errors == 0, "HID reports decode to what was sent");
-  ok &= check(hid.lost == hid.expect_lost && hid.duplicates == hid.expect_duplicates &&
-                  hid.reordered == hid.expect_reordered,
-              "HID loss/duplication/reordering counted as injected");
+  ok &= check(
+      hid.lost == hid.expect_lost && hid.duplicates == hid.expect_duplicates && hid.reordered == hid.expect_reordered,
+      "HID loss/duplication/reordering counted as injected");
   ok &= check(can.errors == 0 && can.mismatches == 0, "CAN cycles decode to what was sent");
   ok &= check(can.complete == can.expect_complete, "every intact CAN cycle assembled, no broken one");
   ok &= check(can.lost == can.expect_lost, "CAN cycle loss counted");

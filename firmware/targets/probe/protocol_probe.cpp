@@ -44,7 +44,7 @@ int main() {
   std::array<std::uint8_t, kMaxMessageSize> buf{};
   std::size_t n = 0;
   g_sink = g_sink + static_cast<std::uint32_t>(encode_response(rsp, buf, n));
-  g_sink = g_sink + static_cast<std::uint32_t>(can::segment(std::span(buf).first(n), can::Function::response, 1,
-                                                            frames, count));
+  g_sink = g_sink +
+           static_cast<std::uint32_t>(can::segment(std::span(buf).first(n), can::Function::response, 1, frames, count));
   return 0;
 }

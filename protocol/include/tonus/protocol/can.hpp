@@ -77,8 +77,8 @@ inline constexpr std::size_t kMaxStreamFrames = 8;  // status + 2 levels + 4 env
 
 // Frames of one stream cycle, in send order. Envelope frames are included only
 // when `with_envelopes` (the device sends them every can_envelope_divider cycles).
-Error encode_stream(const StreamMessage& msg, std::uint8_t node, bool with_envelopes,
-                    std::span<CanFrame> out, std::size_t& count);
+Error encode_stream(const StreamMessage& msg, std::uint8_t node, bool with_envelopes, std::span<CanFrame> out,
+                    std::size_t& count);
 
 // Reassembles stream cycles of one node. Frames of other nodes are ignored.
 // A cycle is delivered when its FLAGS frame arrives and every levels frame the
@@ -129,8 +129,8 @@ Error decode_heartbeat(const CanFrame& frame, Heartbeat& out);
 inline constexpr std::size_t kSegmentData = 7;
 inline constexpr std::size_t kMaxSegments = (kMaxMessageSize + kSegmentData - 1) / kSegmentData;  // 9
 
-Error segment(std::span<const std::uint8_t> message, Function f, std::uint8_t node,
-              std::span<CanFrame> out, std::size_t& count);
+Error segment(std::span<const std::uint8_t> message, Function f, std::uint8_t node, std::span<CanFrame> out,
+              std::size_t& count);
 
 // Collects the segments of one function/node. A new index-0 segment restarts;
 // a gap, duplicate or count change voids the message (Error::out_of_order).

@@ -58,9 +58,9 @@ struct TimeSyncRequest {
 
 struct TimeSyncResponse {
   static constexpr std::size_t kWireSize = 24;
-  std::uint64_t host_time_us = 0;    // t1 echoed
-  std::uint64_t device_rx_us = 0;    // t2
-  std::uint64_t device_tx_us = 0;    // t3
+  std::uint64_t host_time_us = 0;  // t1 echoed
+  std::uint64_t device_rx_us = 0;  // t2
+  std::uint64_t device_tx_us = 0;  // t3
 
   void write(ByteWriter& w) const;
   Error read(ByteReader& r);
@@ -72,9 +72,9 @@ struct DeviceStats {
   static constexpr std::size_t kWireSize = 24;
   std::uint32_t uptime_ms = 0;
   std::uint32_t reports_sent = 0;
-  std::uint32_t lost_blocks = 0;   // sample blocks overwritten before processing
-  std::uint32_t late_blocks = 0;   // blocks processed after their deadline
-  std::uint32_t tx_dropped = 0;    // reports dropped because the link was busy
+  std::uint32_t lost_blocks = 0;  // sample blocks overwritten before processing
+  std::uint32_t late_blocks = 0;  // blocks processed after their deadline
+  std::uint32_t tx_dropped = 0;   // reports dropped because the link was busy
   std::uint16_t commands_rejected = 0;
   std::uint16_t watchdog_resets = 0;
 
@@ -84,9 +84,9 @@ struct DeviceStats {
 };
 
 enum class CalibrationPhase : std::uint8_t {
-  rest = 1,            // baseline per channel, performer relaxed
-  max_contraction = 2, // maximal voluntary contraction per selected channel
-  co_contraction = 3,  // optional co-contraction reference per pair
+  rest = 1,             // baseline per channel, performer relaxed
+  max_contraction = 2,  // maximal voluntary contraction per selected channel
+  co_contraction = 3,   // optional co-contraction reference per pair
 };
 
 // calibration_start request.
@@ -104,17 +104,22 @@ struct CalibrationStart {
 };
 
 enum class CalibrationState : std::uint8_t {
-  idle = 0, running = 1, done = 2, aborted = 3, timed_out = 4, failed = 5,
+  idle = 0,
+  running = 1,
+  done = 2,
+  aborted = 3,
+  timed_out = 4,
+  failed = 5,
 };
 
 // calibration_status response.
 struct CalibrationStatus {
   static constexpr std::size_t kWireSize = 6;
   CalibrationState state = CalibrationState::idle;
-  std::uint8_t phase = 0;            // CalibrationPhase of the current/last phase, 0 = none
-  std::uint8_t progress_pct = 0;     // 0..100
-  std::uint16_t calibrated_mask = 0; // channels holding a valid baseline and gain
-  std::uint8_t phases_done = 0;      // bit (phase-1) set when that phase completed
+  std::uint8_t phase = 0;             // CalibrationPhase of the current/last phase, 0 = none
+  std::uint8_t progress_pct = 0;      // 0..100
+  std::uint16_t calibrated_mask = 0;  // channels holding a valid baseline and gain
+  std::uint8_t phases_done = 0;       // bit (phase-1) set when that phase completed
 
   void write(ByteWriter& w) const;
   Error read(ByteReader& r);
@@ -131,19 +136,19 @@ struct DeviceConfig {
   static constexpr std::size_t kWireSize = 31;
   std::uint16_t sample_rate_hz = 2000;
   std::uint16_t report_rate_hz = 1000;
-  std::uint16_t highpass_dhz = 200;   // 20.0 Hz (SENIAM); 0 = off
-  std::uint16_t lowpass_dhz = 4500;   // 450.0 Hz; 0 = off
-  std::uint8_t notch_hz = 50;         // 0 = off, 50 or 60
-  std::uint8_t notch_harmonics = 4;   // fundamental + harmonics below Nyquist, 1..8
+  std::uint16_t highpass_dhz = 200;  // 20.0 Hz (SENIAM); 0 = off
+  std::uint16_t lowpass_dhz = 4500;  // 450.0 Hz; 0 = off
+  std::uint8_t notch_hz = 50;        // 0 = off, 50 or 60
+  std::uint8_t notch_harmonics = 4;  // fundamental + harmonics below Nyquist, 1..8
   EnvelopeMode envelope_mode = EnvelopeMode::linear;
   std::uint16_t envelope_tau_ms = 100;
   std::array<std::uint8_t, kMaxPairs> pair_group{0, 1, 2, 3, kPairUnused, kPairUnused, kPairUnused, kPairUnused};
   CoContractionMeasure measure = CoContractionMeasure::min_normalised;
-  std::uint16_t dead_band = 1311;     // level units (~2 % of full scale)
-  std::uint16_t hysteresis = 655;     // level units (~1 %)
+  std::uint16_t dead_band = 1311;  // level units (~2 % of full scale)
+  std::uint16_t hysteresis = 655;  // level units (~1 %)
   LevelCurve curve = LevelCurve::linear;
   std::uint16_t curve_exponent_milli = 1000;
-  std::uint8_t can_node_id = 1;       // 0..31
+  std::uint8_t can_node_id = 1;            // 0..31
   std::uint8_t can_envelope_divider = 10;  // envelopes on CAN every Nth report; 0 = never
 
   void write(ByteWriter& w) const;
@@ -154,9 +159,22 @@ struct DeviceConfig {
 // Fields of DeviceConfig in wire order; check_config names the first bad one.
 enum class ConfigField : std::uint8_t {
   none = 0xFF,
-  sample_rate_hz = 0, report_rate_hz, highpass_dhz, lowpass_dhz, notch_hz, notch_harmonics,
-  envelope_mode, envelope_tau_ms, pair_group, measure, dead_band, hysteresis, curve,
-  curve_exponent_milli, can_node_id, can_envelope_divider,
+  sample_rate_hz = 0,
+  report_rate_hz,
+  highpass_dhz,
+  lowpass_dhz,
+  notch_hz,
+  notch_harmonics,
+  envelope_mode,
+  envelope_tau_ms,
+  pair_group,
+  measure,
+  dead_band,
+  hysteresis,
+  curve,
+  curve_exponent_milli,
+  can_node_id,
+  can_envelope_divider,
 };
 
 const char* to_string(ConfigField f);

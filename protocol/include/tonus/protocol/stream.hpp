@@ -28,18 +28,18 @@ inline constexpr std::uint16_t known_mask = 0x001F;
 }  // namespace status_bit
 
 inline constexpr std::size_t kStreamHeaderSize = 18;
-inline constexpr std::uint16_t kLevelMax = 0xFFFF;       // maximal co-contraction
-inline constexpr std::uint16_t kEnvelopeOne = 0x8000;    // envelope == reference (MVC when calibrated)
+inline constexpr std::uint16_t kLevelMax = 0xFFFF;     // maximal co-contraction
+inline constexpr std::uint16_t kEnvelopeOne = 0x8000;  // envelope == reference (MVC when calibrated)
 
 struct StreamMessage {
-  std::uint16_t sequence = 0;        // +1 per report, wraps at 2^16
-  std::uint32_t device_time_us = 0;  // device monotonic clock, wraps at 2^32 us (~71.6 min)
-  std::uint16_t status = 0;          // status_bit::*
-  std::uint16_t electrode_off = 0;   // bit i: channel i has lost skin contact
-  std::uint16_t saturation = 0;      // bit i: channel i clipped in the last window
-  std::uint16_t artifact = 0;        // bit i: motion artifact on channel i
-  std::uint8_t group_count = 4;      // 1..kMaxGroups
-  std::uint8_t channel_count = 8;    // 1..kMaxChannels
+  std::uint16_t sequence = 0;                           // +1 per report, wraps at 2^16
+  std::uint32_t device_time_us = 0;                     // device monotonic clock, wraps at 2^32 us (~71.6 min)
+  std::uint16_t status = 0;                             // status_bit::*
+  std::uint16_t electrode_off = 0;                      // bit i: channel i has lost skin contact
+  std::uint16_t saturation = 0;                         // bit i: channel i clipped in the last window
+  std::uint16_t artifact = 0;                           // bit i: motion artifact on channel i
+  std::uint8_t group_count = 4;                         // 1..kMaxGroups
+  std::uint8_t channel_count = 8;                       // 1..kMaxChannels
   std::array<std::uint16_t, kMaxGroups> levels{};       // 0 relaxed .. 65535 maximal co-contraction
   std::array<std::uint16_t, kMaxChannels> envelopes{};  // Q1.15: 32768 == reference, saturates
 
