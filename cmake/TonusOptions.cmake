@@ -4,6 +4,15 @@ option(TONUS_TARGET_ARM "Cross build for the Cortex-M4F band (set by the arm pre
 option(TONUS_FUZZ "Build the libFuzzer targets (clang only, set by the fuzz preset)" OFF)
 option(TONUS_WERROR "Treat warnings as errors" ON)
 
+# Real mocap and EMG recordings (../shared/data beside the checkout) that tests
+# read; they are not copied into the repository (see their SOURCES.md).
+set(_tonus_shared_default "${PROJECT_SOURCE_DIR}/../shared/data")
+if(NOT EXISTS "${_tonus_shared_default}" AND EXISTS "/work/shared/data")
+  set(_tonus_shared_default "/work/shared/data")
+endif()
+set(TONUS_SHARED_DATA_DIR "${_tonus_shared_default}" CACHE PATH "Folder holding bvh/ and emg/ recordings")
+cmake_path(ABSOLUTE_PATH TONUS_SHARED_DATA_DIR NORMALIZE)
+
 # Warnings for every target of ours; third-party headers come in as SYSTEM.
 add_library(tonus_warnings INTERFACE)
 target_compile_options(tonus_warnings INTERFACE
