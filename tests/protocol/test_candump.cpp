@@ -131,3 +131,43 @@ TEST_CASE("can-utils log2asc reads a log we wrote") {
   CHECK(output.find("AA BB") != std::string::npos);
   CHECK(output.find("0.000150") != std::string::npos);  // relative time of the second frame
 }
+
+TEST_CASE("candump parser: every truncation and single-character corruption is an error or a consistent record") {
+  const std::string line =
+      format_line(make_record(1700000000123456ULL, "can0", 0x1E1, {0x04, 0x00, 0x80, 0x00, 0x00, 0x00, 0x37, 0x34}));
+  // The format has no length field: a line cut inside the data at a byte
+  // boundary is a valid shorter frame. Any other cut is an error.
+  const std::size_t data_start = line.find('#') + 1;
+  for (std::size_t len = 0; len < line.size() - 1; ++len) {
+    Record r{};
+    CAPTURE(len);
+    const Error e = parse(std::string_view(line).substr(0, len), r);
+    if (len >= data_start && (len - data_start) % 2 == 0) {
+      REQUIRE(e == Error::ok);
+      CHECK(r.frame.dlc == (len - data_start) / 2);
+      CHECK(r.frame.id == 0x1E1);
+    } else {
+      CHECK(e != Error::ok);
+    }
+  }
+  std::size_t accepted = 0;
+  std::string copy = line;
+  for (std::size_t i = 0; i + 1 < copy.size(); ++i) {  // the newline stays
+    const char original = copy[i];
+    for (int c = 0; c < 256; ++c) {
+      if (static_cast<char>(c) == original) continue;
+      copy[i] = static_cast<char>(c);
+      Record r{};
+      if (parse(copy, r) == Error::ok) {
+        // Whatever was accepted must format back to a line that parses to the same record.
+        ++accepted;
+        Record again{};
+        REQUIRE(parse(format_line(r), again) == Error::ok);
+        CHECK(again == r);
+      }
+    }
+    copy[i] = original;
+  }
+  // Hex digits of the id and data may change into other hex digits: those are valid frames.
+  CHECK(accepted > 0);
+}
