@@ -41,7 +41,10 @@ struct CanFrame {
   std::uint8_t flags = 0;
   std::array<std::uint8_t, 8> data{};
 
-  [[nodiscard]] std::span<const std::uint8_t> payload() const { return {data.data(), dlc}; }
+  // Clamped to the 8 data bytes, so a frame with an invalid dlc can never be read past its end.
+  [[nodiscard]] std::span<const std::uint8_t> payload() const {
+    return {data.data(), dlc <= data.size() ? dlc : data.size()};
+  }
   friend bool operator==(const CanFrame&, const CanFrame&) = default;
 };
 

@@ -10,11 +10,9 @@ namespace tonus::proto {
 
 constexpr std::uint16_t crc16_ccitt(std::span<const std::uint8_t> data, std::uint16_t crc = 0xFFFF) {
   for (std::uint8_t byte : data) {
-    crc = static_cast<std::uint16_t>(crc ^ (static_cast<std::uint16_t>(byte) << 8U));
-    for (int bit = 0; bit < 8; ++bit) {
-      crc = (crc & 0x8000U) != 0 ? static_cast<std::uint16_t>((crc << 1U) ^ 0x1021U)
-                                 : static_cast<std::uint16_t>(crc << 1U);
-    }
+    unsigned c = crc ^ (static_cast<unsigned>(byte) << 8U);
+    for (int bit = 0; bit < 8; ++bit) c = (c & 0x8000U) != 0 ? (c << 1U) ^ 0x1021U : c << 1U;
+    crc = static_cast<std::uint16_t>(c);
   }
   return crc;
 }

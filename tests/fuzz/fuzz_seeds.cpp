@@ -1,0 +1,139 @@
+// Writes a seed corpus of valid encodings for every fuzz target, so short
+// fuzz runs start from deep inside the decoders instead of from nothing.
+// Usage: fuzz_seeds OUT_DIR  (creates OUT_DIR/<target>/seed-N files)
+#include <array>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "tonus/protocol/can.hpp"
+#include "tonus/protocol/candump.hpp"
+#include "tonus/protocol/command.hpp"
+#include "tonus/protocol/hid.hpp"
+#include "tonus/protocol/payloads.hpp"
+#include "tonus/protocol/stream.hpp"
+
+using namespace tonus::proto;
+namespace fs = std::filesystem;
+
+namespace {
+
+void write(const fs::path& dir, int& counter, const std::vector<std::uint8_t>& bytes) {
+  std::ofstream out(dir / ("seed-" + std::to_string(counter++)), std::ios::binary);
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+}
+
+StreamMessage stream_message(std::uint8_t groups, std::uint8_t channels) {
+  StreamMessage m{};
+  m.group_count = groups;
+  m.channel_count = channels;
+  m.sequence = 0xFFFE;
+  m.device_time_us = 0xFFFFFF00U;
+  m.status = status_bit::calibrated | status_bit::block_lost;
+  m.electrode_off = 1;
+  for (std::size_t g = 0; g < groups; ++g) m.levels[g] = static_cast<std::uint16_t>(9000 * (g + 1));
+  for (std::size_t c = 0; c < channels; ++c) m.envelopes[c] = static_cast<std::uint16_t>(1000 * (c + 1));
+  return m;
+}
+
+std::vector<Request> requests() {
+  std::vector<Request> out;
+  Request r{};
+  (void)make_request(Opcode::time_sync, 1, TimeSyncRequest{123456789}, r);
+  out.push_back(r);
+  (void)make_request(Opcode::set_config, 2, DeviceConfig{}, r);
+  out.push_back(r);
+  (void)make_request(Opcode::calibration_start, 3, CalibrationStart{}, r);
+  out.push_back(r);
+  (void)make_request(Opcode::reset, 4, ResetRequest{ResetKind::factory_defaults}, r);
+  out.push_back(r);
+  out.push_back(make_request(Opcode::get_device_info, 5));
+  return out;
+}
+
+std::vector<Response> responses() {
+  std::vector<Response> out;
+  Response r{};
+  const Request q = make_request(Opcode::get_device_info, 9);
+  (void)make_response(q, Status::ok, DeviceInfo{}, r);
+  out.push_back(r);
+  (void)make_response(q, Status::ok, TimeSyncResponse{1, 2, 3}, r);
+  out.push_back(r);
+  (void)make_response(q, Status::ok, DeviceStats{}, r);
+  out.push_back(r);
+  (void)make_response(q, Status::ok, CalibrationStatus{}, r);
+  out.push_back(r);
+  (void)make_response(q, Status::ok, DeviceConfig{}, r);
+  out.push_back(r);
+  (void)make_response(q, Status::bad_value, SetConfigResult{ConfigField::lowpass_dhz}, r);
+  out.push_back(r);
+  return out;
+}
+
+template <class Message, class Encode>
+std::vector<std::uint8_t> bytes_of(const Message& m, Encode encode) {
+  std::array<std::uint8_t, kMaxMessageSize> buf{};
+  std::size_t n = 0;
+  (void)encode(m, buf, n);
+  return {buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n)};
+}
+
+// Frames in the layout fuzz_can.cpp reads: id u16, dlc, flags, 8 data bytes.
+void append_frame(std::vector<std::uint8_t>& out, const CanFrame& f) {
+  out.push_back(static_cast<std::uint8_t>(f.id));
+  out.push_back(static_cast<std::uint8_t>(f.id >> 8U));
+  out.push_back(f.dlc);
+  out.push_back(f.flags);
+  out.insert(out.end(), f.data.begin(), f.data.end());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: %s OUT_DIR\n", argv[0]);
+    return 2;
+  }
+  const fs::path root(argv[1]);
+  for (const char* t : {"stream", "command", "hid_descriptor", "can", "candump"}) fs::create_directories(root / t);
+  int n = 0;
+
+  for (auto [g, c] : {std::pair<std::uint8_t, std::uint8_t>{4, 8}, {1, 1}, {6, 16}, {5, 13}}) {
+    const StreamMessage m = stream_message(g, c);
+    write(root / "stream", n, bytes_of(m, encode_stream));
+    hid::Report report{};
+    (void)hid::pack_stream(m, report);
+    write(root / "stream", n, {report.begin(), report.end()});
+  }
+  for (const Request& r : requests()) write(root / "command", n, bytes_of(r, encode_request));
+  for (const Response& r : responses()) write(root / "command", n, bytes_of(r, encode_response));
+  write(root / "hid_descriptor", n, {hid::kReportDescriptor.begin(), hid::kReportDescriptor.end()});
+
+  constexpr std::uint8_t kNode = 1;
+  std::vector<std::uint8_t> frames{kNode};
+  std::array<CanFrame, can::kMaxStreamFrames> cycle{};
+  std::size_t count = 0;
+  (void)can::encode_stream(stream_message(6, 16), kNode, true, cycle, count);
+  for (std::size_t i = 0; i < count; ++i) append_frame(frames, cycle[i]);
+  const auto req = bytes_of(requests()[1], encode_request);
+  std::array<CanFrame, can::kMaxSegments> segs{};
+  (void)can::segment(req, can::Function::request, kNode, segs, count);
+  for (std::size_t i = 0; i < count; ++i) append_frame(frames, segs[i]);
+  append_frame(frames, can::encode_heartbeat(can::Heartbeat{}, kNode));
+  write(root / "can", n, frames);
+
+  for (std::size_t i = 0; i < cycle.size(); ++i) {
+    candump::Record rec{};
+    rec.time_us = 1700000000000000ULL + i;
+    (void)candump::set_iface(rec, "can0");
+    rec.frame = cycle[i];
+    std::array<char, candump::kMaxLine> line{};
+    std::size_t len = 0;
+    if (candump::format(rec, line, len) == Error::ok) write(root / "candump", n, {line.begin(), line.begin() + len});
+  }
+  std::printf("fuzz_seeds: wrote %d seeds under %s\n", n, root.c_str());
+  return 0;
+}
