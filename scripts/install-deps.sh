@@ -7,7 +7,7 @@ packages=(
   # toolchain
   build-essential cmake ninja-build git pkg-config
   clang clang-14 clang-format clang-tidy libclang-rt-14-dev lld
-  gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi
+  gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi libstdc++-arm-none-eabi-newlib
   # libraries
   doctest-dev libeigen3-dev libbenchmark-dev
   libhidapi-dev libusb-1.0-0-dev libgpiod-dev
@@ -36,5 +36,11 @@ fi
 
 export DEBIAN_FRONTEND=noninteractive
 echo "install-deps: installing ${#missing[@]} package(s): ${missing[*]}"
-apt-get update -qq
-apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
+# Quiet on success; the whole apt log on failure.
+if ! { apt-get update -qq && apt-get install -y -qq --no-install-recommends "${missing[@]}"; } >"$log" 2>&1; then
+  cat "$log" >&2
+  echo "install-deps: apt-get failed" >&2
+  exit 1
+fi

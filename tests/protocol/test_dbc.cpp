@@ -87,7 +87,9 @@ void check_frame(const DbcMessage& msg, const CanFrame& frame, const std::map<st
     const double physical = static_cast<double>(s.raw(frame.payload())) * s.factor + s.offset;
     CHECK(physical == doctest::Approx(it->second).epsilon(1e-9));
   }
-  for (const auto& [name, value] : expect) CHECK_MESSAGE(names.count(name) == 1, "codec field missing: " << name);
+  for (const auto& field : expect) {
+    CHECK_MESSAGE(names.count(field.first) == 1, "codec field missing: " << field.first);
+  }
   // Signals of a frame never overlap.
   std::array<int, 64> owner{};
   for (const auto& s : msg.signals) {

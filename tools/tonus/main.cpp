@@ -1,8 +1,13 @@
+#include <fmt/core.h>
 #include <CLI/CLI.hpp>
+
+#include <exception>
 
 #include "protocol_demo.hpp"
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
   CLI::App app{"tonus: EMG-driven avatar stiffness (band protocol, physics, balance)"};
   app.require_subcommand(1);
 
@@ -23,4 +28,18 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   if (demo_cmd->parsed()) return tonus::tools::run_protocol_demo(demo);
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Errors are reported, never escape as an abort: a tool run by scripts must exit with a code.
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "tonus: error: {}\n", e.what());
+  } catch (...) {
+    fmt::print(stderr, "tonus: unknown error\n");
+  }
+  return 1;
 }

@@ -53,10 +53,10 @@ struct SegmentParams {
   std::string_view name;
   std::string_view proximal;  // landmark the length and the CM position are measured from
   std::string_view distal;
-  double length_m;            // mean length in de Leva's sample
-  double mass_fraction;       // of total body mass
-  double com_fraction;        // CM distance from `proximal`, as a fraction of the length
-  double rg_sagittal;         // radii of gyration, fractions of the length
+  double length_m;       // mean length in de Leva's sample
+  double mass_fraction;  // of total body mass
+  double com_fraction;   // CM distance from `proximal`, as a fraction of the length
+  double rg_sagittal;    // radii of gyration, fractions of the length
   double rg_transverse;
   double rg_longitudinal;
 };

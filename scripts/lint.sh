@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Formatting and static analysis, both clean on the tree or this fails.
+# Needs the compile databases of the release (and, if present, fuzz) builds.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+mapfile -t sources < <(git ls-files '*.cpp' '*.hpp' '*.h' '*.c')
+clang-format --dry-run --Werror "${sources[@]}"
+echo "lint: clang-format clean (${#sources[@]} files)"
+
+# clang-tidy on every translation unit of ours, each with the build that compiles it.
+tidy() {
+  local build=$1
+  shift
+  [ "$#" -eq 0 ] && return 0
+  printf '%s\n' "$@" | xargs -P "$(nproc)" -n 4 clang-tidy -p "$build" --quiet 2>&1 |
+    grep -vE '^[0-9]+ warnings? (generated|treated)|^Suppressed|^Use -header-filter|^$' || true
+}
+mapfile -t host_tus < <(git ls-files '*.cpp' | grep -vE '^tests/fuzz/|^firmware/targets/(cortex-m4|probe)/')
+mapfile -t fuzz_tus < <(git ls-files 'tests/fuzz/*.cpp')
+out=$(tidy build/release "${host_tus[@]}")
+if [ -d build/fuzz ]; then out+=$(tidy build/fuzz "${fuzz_tus[@]}"); fi
+if [ -n "$out" ]; then
+  echo "$out"
+  echo "lint: clang-tidy found problems" >&2
+  exit 1
+fi
+echo "lint: clang-tidy clean"

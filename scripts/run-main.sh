@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# The main job on embedded defaults (no hardware, no config file): builds the
+# release preset and runs what tonus does end to end today.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+cmake --preset release >/dev/null
+cmake --build --preset release
+
+# A simulated band stream pushed through the USB-HID and CAN bindings over
+# lossy links and decoded back, with every message accounted for.
+build/release/bin/tonus demo --seconds 5 --loss 0.01 --duplication 0.002 --reorder 0.002 --seed 1
