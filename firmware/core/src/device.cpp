@@ -235,6 +235,7 @@ void Device::emit_report(std::uint64_t t_us) {
   block_lost_pending_ = false;
   report_ = m;
   ++stats_.reports_sent;
+  if (observer_ != nullptr) observer_(observer_context_, m);
 
   if (board_.hid != nullptr && board_.hid->connected()) {
     proto::hid::Report r{};

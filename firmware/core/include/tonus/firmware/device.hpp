@@ -46,6 +46,13 @@ class Device {
   void boot();
   void poll();
 
+  // Optional hook called with every report built (simulator summaries, tests).
+  using ReportObserver = void (*)(void* context, const proto::StreamMessage& report);
+  void set_report_observer(ReportObserver fn, void* context) {
+    observer_ = fn;
+    observer_context_ = context;
+  }
+
   // Command handling, transport-independent (also used by tests directly).
   void handle(const proto::Request& req, std::uint64_t rx_us, proto::Response& rsp);
 
@@ -108,6 +115,8 @@ class Device {
   std::uint64_t next_heartbeat_us_ = 0;
   proto::can::Reassembler can_requests_{proto::can::Function::request, 1};
   bool reset_pending_ = false;
+  ReportObserver observer_ = nullptr;
+  void* observer_context_ = nullptr;
   proto::ResetKind reset_kind_ = proto::ResetKind::reboot;
 };
 
