@@ -39,8 +39,8 @@ bool quality_step(const QualityModel& m, QualityState& s, std::int16_t raw, cons
   QualityFlags f;
   s.flat_windows = s.lo == s.hi ? s.flat_windows + 1 : 0;
   const bool stuck = s.at_rail >= m.stuck_count || s.flat_windows >= kFlatWindows;
-  const bool hum_dominates = m.hum_check && s.hum_power > fe.hum_floor * fe.hum_floor &&
-                             s.hum_power > kHumDominanceRatio * s.emg_power;
+  const bool hum_dominates =
+      m.hum_check && s.hum_power > fe.hum_floor * fe.hum_floor && s.hum_power > kHumDominanceRatio * s.emg_power;
   f.electrode_off = stuck || hum_dominates;
   f.saturation = s.clipped >= m.saturation_count && !stuck;
 

@@ -69,7 +69,8 @@ float sin_turns(float turns) {
   if (x > kPi / 2.0F) x = kPi - x;
   if (x < -kPi / 2.0F) x = -kPi - x;
   const float x2 = x * x;
-  return x * (1.0F - x2 / 6.0F * (1.0F - x2 / 20.0F * (1.0F - x2 / 42.0F * (1.0F - x2 / 72.0F * (1.0F - x2 / 110.0F)))));
+  return x *
+         (1.0F - x2 / 6.0F * (1.0F - x2 / 20.0F * (1.0F - x2 / 42.0F * (1.0F - x2 / 72.0F * (1.0F - x2 / 110.0F)))));
 }
 
 SyntheticEmg::SyntheticEmg(const SynthSpec& spec) : spec_(spec), rng_(spec.seed) {
@@ -132,7 +133,8 @@ bool SyntheticEmg::lose_block(std::size_t first, std::size_t count) const {
 float SyntheticEmg::sample(std::size_t ch, float t) {
   const float T = spec_.seconds;
   const float white = rng_.gaussian();
-  const float shaped = shape_gain_ * biquad_step(shape_lp_, lp_state_[ch], biquad_step(shape_hp_, hp_state_[ch], white));
+  const float shaped =
+      shape_gain_ * biquad_step(shape_lp_, lp_state_[ch], biquad_step(shape_hp_, hp_state_[ch], white));
   float emg = activation(ch, t) * spec_.mvc_rms_counts * gain_[ch] * shaped;
   const float noise = spec_.noise_rms_counts * rng_.gaussian();
   float hum_amp = spec_.hum_counts;
@@ -147,7 +149,8 @@ float SyntheticEmg::sample(std::size_t ch, float t) {
       emg *= 12.0F;
     }
     if (ch == FaultScript::kArtifactChannel && between(t, T, FaultScript::kArtifactStart, FaultScript::kArtifactEnd)) {
-      const float u = (t - FaultScript::kArtifactStart * T) / ((FaultScript::kArtifactEnd - FaultScript::kArtifactStart) * T);
+      const float u =
+          (t - FaultScript::kArtifactStart * T) / ((FaultScript::kArtifactEnd - FaultScript::kArtifactStart) * T);
       extra = 900.0F * sin_turns(0.5F * u);  // one slow half-wave swing of the baseline
     }
   }

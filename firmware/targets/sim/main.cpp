@@ -1,8 +1,8 @@
 // tonus-band-sim: the band's firmware core on Linux, the hardware-in-loop stub
 // for tests and for the host daemon. See firmware/README.md.
-#include <CLI/CLI.hpp>
 #include <fmt/core.h>
 #include <fmt/os.h>
+#include <CLI/CLI.hpp>
 
 #include <csignal>
 #include <cstdio>
@@ -84,8 +84,9 @@ void write_json(const std::string& path, const Options& opt, const std::string& 
   out.print("  \"levels_mean\": {},\n", list(mean));
   out.print("  \"flags_seen\": {{\"electrode_off\": {}, \"saturation\": {}, \"artifact\": {}, \"block_lost\": {}}},\n",
             channels(s.electrode_off), channels(s.saturation), channels(s.artifact), s.block_lost_reports > 0);
-  out.print("  \"first_flag_s\": {{\"electrode_off\": {}, \"saturation\": {}, \"artifact\": {}, \"block_lost\": {:.4f}}},\n",
-            list(s.first_off_s), list(s.first_saturation_s), list(s.first_artifact_s), s.first_block_lost_s);
+  out.print(
+      "  \"first_flag_s\": {{\"electrode_off\": {}, \"saturation\": {}, \"artifact\": {}, \"block_lost\": {:.4f}}},\n",
+      list(s.first_off_s), list(s.first_saturation_s), list(s.first_artifact_s), s.first_block_lost_s);
   out.print("  \"status_seen\": {},\n", s.status_seen);
   out.print("  \"group_delay_ms\": {{\"filters\": {:.3f}, \"envelope\": {:.3f}, \"total\": {:.3f}}}\n",
             delay.filters_s * 1e3, delay.envelope_s * 1e3, delay.total_s() * 1e3);
@@ -207,8 +208,8 @@ int run(const Options& opt) {
   if (!opt.quiet) {
     fmt::print("tonus-band-sim: {}, {:.2f} s at {} Hz, reports at {} Hz\n", source_name, seconds,
                device.config().sample_rate_hz, device.config().report_rate_hz);
-    fmt::print("  reports {}  lost blocks {}  late blocks {}  tx dropped {}  sequence {}\n", s.reports,
-               st.lost_blocks, st.late_blocks, st.tx_dropped, s.sequence_continuous ? "continuous" : "GAPS");
+    fmt::print("  reports {}  lost blocks {}  late blocks {}  tx dropped {}  sequence {}\n", s.reports, st.lost_blocks,
+               st.late_blocks, st.tx_dropped, s.sequence_continuous ? "continuous" : "GAPS");
     for (std::size_t g = 0; g < fw::kGroups; ++g) {
       fmt::print("  group {}: level min {:5}  max {:5}  mean {:8.1f}\n", g, s.reports ? s.levels_min[g] : 0,
                  s.levels_max[g], s.reports ? s.levels_sum[g] / static_cast<double>(s.reports) : 0.0);
@@ -228,9 +229,10 @@ int run(const Options& opt) {
 int main(int argc, char** argv) {
   CLI::App app{"tonus-band-sim: the band firmware core on Linux (synthetic EMG or a recording)"};
   Options opt;
-  auto* synth = app.add_option("--synthetic", opt.synthetic, "scenario: rest, ramp, faults, bursts, hum, dropout, selftest");
-  auto* rec = app.add_option("--recording", opt.recording, "EMG recording (BioSPPy text or Myo CSV)")
-                  ->check(CLI::ExistingFile);
+  auto* synth =
+      app.add_option("--synthetic", opt.synthetic, "scenario: rest, ramp, faults, bursts, hum, dropout, selftest");
+  auto* rec =
+      app.add_option("--recording", opt.recording, "EMG recording (BioSPPy text or Myo CSV)")->check(CLI::ExistingFile);
   synth->excludes(rec);
   app.add_option("--seconds", opt.seconds, "duration (synthetic) or maximum length (recording)")
       ->check(CLI::Range(0.0, 86400.0));

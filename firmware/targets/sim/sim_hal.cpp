@@ -108,7 +108,8 @@ bool SimSampler::start(std::uint16_t rate_hz) {
 }
 
 std::uint64_t SimSampler::next_block_start_us() const {
-  return static_cast<std::uint64_t>(static_cast<double>(frames_done_) * 1e6 / static_cast<double>(source_.sample_rate_hz()));
+  return static_cast<std::uint64_t>(static_cast<double>(frames_done_) * 1e6 /
+                                    static_cast<double>(source_.sample_rate_hz()));
 }
 
 bool SimSampler::produce() {

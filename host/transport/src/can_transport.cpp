@@ -114,8 +114,8 @@ SeqpacketCanTransport::~SeqpacketCanTransport() {
 int SeqpacketCanTransport::read(proto::CanFrame& out, int timeout_ms) {
   for (;;) {
     can_frame f{};
-    const long n = detail::receive_datagram(fd_, std::span(reinterpret_cast<std::uint8_t*>(&f), sizeof f),
-                                            timeout_ms, error_);
+    const long n =
+        detail::receive_datagram(fd_, std::span(reinterpret_cast<std::uint8_t*>(&f), sizeof f), timeout_ms, error_);
     if (n <= 0) return static_cast<int>(n);
     if (n != static_cast<long>(sizeof f)) continue;  // CAN_RAW would not deliver it either
     out = from_socketcan(f);

@@ -58,8 +58,8 @@ std::string check_band_descriptor(std::span<const std::uint8_t> descriptor) {
   return {};
 }
 
-std::unique_ptr<HidapiTransport> HidapiTransport::open(std::uint16_t vid, std::uint16_t pid,
-                                                       const std::wstring& serial, std::string& error) {
+std::unique_ptr<HidapiTransport> HidapiTransport::open(std::uint16_t vid, std::uint16_t pid, const std::wstring& serial,
+                                                       std::string& error) {
   if (hid_init() != 0) {
     error = "hid_init failed: " + narrow(hid_error(nullptr));
     return nullptr;

@@ -22,18 +22,18 @@
 
 namespace tonus::fw {
 
-inline constexpr float kMvcOverRest = 2.0F;       // an MVC envelope must at least double the rest one
-inline constexpr float kMinCoContraction = 0.05F; // below this the co-contraction reference is noise
-inline constexpr float kMinValidFraction = 0.5F;  // of a phase's samples with the electrode on
+inline constexpr float kMvcOverRest = 2.0F;        // an MVC envelope must at least double the rest one
+inline constexpr float kMinCoContraction = 0.05F;  // below this the co-contraction reference is noise
+inline constexpr float kMinValidFraction = 0.5F;   // of a phase's samples with the electrode on
 inline constexpr std::uint32_t kCalibrationGraceMs = 1000;
 
 struct Calibration {
-  std::array<float, kChannels> baseline{};      // rest envelope, ADC counts
-  std::array<float, kChannels> reference{};     // MVC envelope, ADC counts
-  std::array<float, kPairs> cocontraction{};    // measure at the reference effort (0..1), 1 when unset
-  std::uint16_t baseline_mask = 0;              // channels with a measured baseline
-  std::uint16_t reference_mask = 0;             // channels with a measured MVC
-  std::uint8_t cocontraction_mask = 0;          // pairs with a measured co-contraction reference
+  std::array<float, kChannels> baseline{};    // rest envelope, ADC counts
+  std::array<float, kChannels> reference{};   // MVC envelope, ADC counts
+  std::array<float, kPairs> cocontraction{};  // measure at the reference effort (0..1), 1 when unset
+  std::uint16_t baseline_mask = 0;            // channels with a measured baseline
+  std::uint16_t reference_mask = 0;           // channels with a measured MVC
+  std::uint8_t cocontraction_mask = 0;        // pairs with a measured co-contraction reference
 
   [[nodiscard]] std::uint16_t calibrated_mask() const {
     return static_cast<std::uint16_t>(baseline_mask & reference_mask);

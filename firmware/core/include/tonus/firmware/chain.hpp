@@ -22,10 +22,10 @@
 
 namespace tonus::fw {
 
-inline constexpr double kDcTrackerHz = 0.5;        // DC removal corner, far below the 20 Hz high-pass
-inline constexpr double kNotchBandwidthHz = 4.0;   // tolerates +-0.2 Hz mains drift with >= 20 dB rejection
-inline constexpr double kButterworthOrder = 4.0;   // high-pass and low-pass orders (2 sections each)
-inline constexpr double kReferenceEmgHz = 80.0;    // typical surface-EMG median frequency (De Luca 1997)
+inline constexpr double kDcTrackerHz = 0.5;       // DC removal corner, far below the 20 Hz high-pass
+inline constexpr double kNotchBandwidthHz = 4.0;  // tolerates +-0.2 Hz mains drift with >= 20 dB rejection
+inline constexpr double kButterworthOrder = 4.0;  // high-pass and low-pass orders (2 sections each)
+inline constexpr double kReferenceEmgHz = 80.0;   // typical surface-EMG median frequency (De Luca 1997)
 
 struct ChainModel {
   float sample_rate_hz = 2000.0F;
@@ -37,10 +37,10 @@ struct ChainModel {
   std::array<float, kMaxNotches> notch_hz{};
   std::size_t lowpass_sections = 0;
   std::array<Biquad, 2> lowpass{};
-  float lowpass_hz = 0.0F;          // realised corner, 0 when dropped (at or above Nyquist)
-  bool lowpass_dropped = false;     // configured but not realisable at this rate
+  float lowpass_hz = 0.0F;       // realised corner, 0 when dropped (at or above Nyquist)
+  bool lowpass_dropped = false;  // configured but not realisable at this rate
   proto::EnvelopeMode envelope_mode = proto::EnvelopeMode::linear;
-  float envelope_alpha = 0.0F;      // one-pole envelope gain: 1 - exp(-1 / (tau fs))
+  float envelope_alpha = 0.0F;         // one-pole envelope gain: 1 - exp(-1 / (tau fs))
   std::uint32_t rms_slot_samples = 1;  // samples summed per RMS slot
   std::uint32_t rms_slots = 1;         // slots in the RMS window
 };

@@ -17,13 +17,13 @@
 namespace tonus::fw {
 
 inline constexpr float kQualityWindowS = 0.1F;
-inline constexpr float kHumDominanceRatio = 4.0F;     // hum power / EMG power (6 dB)
-inline constexpr float kStuckFraction = 0.9F;         // of a window at a rail
-inline constexpr float kSaturationFraction = 0.01F;   // of a window clipped (at least 2 samples)
-inline constexpr float kArtifactEmgRatio = 4.0F;      // low-frequency power / in-band EMG power
-inline constexpr float kArtifactBaselineRatio = 8.0F; // low-frequency power / its slow baseline
+inline constexpr float kHumDominanceRatio = 4.0F;      // hum power / EMG power (6 dB)
+inline constexpr float kStuckFraction = 0.9F;          // of a window at a rail
+inline constexpr float kSaturationFraction = 0.01F;    // of a window clipped (at least 2 samples)
+inline constexpr float kArtifactEmgRatio = 10.0F;      // low-frequency power / in-band EMG power (10 dB)
+inline constexpr float kArtifactBaselineRatio = 8.0F;  // low-frequency power / its slow baseline
 inline constexpr float kArtifactBaselineS = 2.0F;
-inline constexpr std::uint32_t kFlatWindows = 3;      // consecutive windows of one constant code
+inline constexpr std::uint32_t kFlatWindows = 3;  // consecutive windows of one constant code
 
 struct QualityModel {
   FrontEnd front_end{};

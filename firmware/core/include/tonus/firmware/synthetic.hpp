@@ -35,12 +35,12 @@ bool parse_scenario(const char* name, Scenario& out);
 
 // Times of the scripted faults of Scenario::faults, as fractions of the duration.
 struct FaultScript {
-  static constexpr std::size_t kOffChannel = 2;        // electrode lifted: mains hum, no EMG
+  static constexpr std::size_t kOffChannel = 2;  // electrode lifted: mains hum, no EMG
   static constexpr float kOffStart = 0.20F, kOffEnd = 0.35F;
   static constexpr std::size_t kSaturatedChannel = 5;  // gain far too high: clips at both rails
   static constexpr float kSatStart = 0.45F, kSatEnd = 0.55F;
-  static constexpr float kLostBlockAt = 0.65F;         // the sampler loses one block
-  static constexpr std::size_t kArtifactChannel = 0;   // cable motion: a 400 ms low-frequency swing
+  static constexpr float kLostBlockAt = 0.65F;        // the sampler loses one block
+  static constexpr std::size_t kArtifactChannel = 0;  // cable motion: a 400 ms low-frequency swing
   static constexpr float kArtifactStart = 0.75F, kArtifactEnd = 0.80F;
 };
 
@@ -50,9 +50,9 @@ struct SynthSpec {
   float sample_rate_hz = 2000.0F;
   float seconds = 10.0F;
   float mains_hz = 50.0F;
-  float hum_counts = 3.0F;         // hum amplitude with electrodes on
-  float noise_rms_counts = 4.0F;   // amplifier + electrode noise
-  float mvc_rms_counts = 300.0F;   // EMG RMS at activation 1 (before the per-channel gain)
+  float hum_counts = 3.0F;        // hum amplitude with electrodes on
+  float noise_rms_counts = 4.0F;  // amplifier + electrode noise
+  float mvc_rms_counts = 300.0F;  // EMG RMS at activation 1 (before the per-channel gain)
 };
 
 // Deterministic xorshift64* generator.
