@@ -47,7 +47,8 @@ std::unique_ptr<SocketCanTransport> SocketCanTransport::open(const std::string& 
   }
   const int fd = ::socket(PF_CAN, SOCK_RAW | SOCK_CLOEXEC, CAN_RAW);
   if (fd < 0) {
-    error = std::string("socket(PF_CAN): ") + std::strerror(errno) + " (is the can module loaded?)";
+    error = "cannot open CAN interface '" + iface + "': socket(PF_CAN): " + std::strerror(errno) +
+            " (is the can module loaded?)";
     return nullptr;
   }
   ifreq ifr{};
