@@ -25,7 +25,12 @@ struct SelftestResult {
   std::int32_t highpass_corner_mdb = 0;  // HP cascade at 20 Hz, milli-dB (-3010 expected)
   std::uint32_t group_delay_us = 0;      // whole chain at 80 Hz
   std::uint16_t stream_crc = 0;          // CRC-16 over every encoded stream message
+  std::uint64_t poll_ticks = 0;          // ticks of the caller's counter spent inside Device::poll
+  std::uint32_t frames = 0;              // frames processed by those polls
 };
+
+// A free-running tick counter read around each Device::poll (nullptr: not measured).
+using TickCounter = std::uint32_t (*)();
 
 inline constexpr std::uint32_t kSelftestSampleRateHz = 2000;
 inline constexpr float kSelftestSeconds = 2.0F;
@@ -34,7 +39,9 @@ inline constexpr std::uint64_t kSelftestSeed = 20240905;
 // Called with each report (e.g. to stream the first ones over a UART).
 using SelftestSink = void (*)(void* context, const proto::StreamMessage& report);
 
-void run_selftest(SelftestResult& out, SelftestSink sink = nullptr, void* context = nullptr);
+// `ticks` returns a counter that increases (mod 2^32) while the core runs.
+void run_selftest(SelftestResult& out, SelftestSink sink = nullptr, void* context = nullptr,
+                  TickCounter ticks = nullptr);
 
 // Writes "key=value" lines (NUL-terminated) into `out`; returns the length.
 std::size_t format_selftest(const SelftestResult& r, char* out, std::size_t capacity);

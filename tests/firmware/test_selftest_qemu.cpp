@@ -76,7 +76,7 @@ TEST_CASE("self-test on the Cortex-M4 (QEMU) matches the host build") {
                                                               "cmake --build --preset arm)");
   const std::string usart =
       (std::filesystem::temp_directory_path() / ("tonus-usart-" + std::to_string(::getpid()) + ".bin")).string();
-  const std::string cmd = "timeout 60 " + qemu + " -M netduinoplus2 -nographic -monitor none -serial file:" + usart +
+  const std::string cmd = "timeout 60 " + qemu + " -M netduinoplus2 -nographic -monitor none -icount shift=0 -serial file:" + usart +
                           " -semihosting-config enable=on,target=native -kernel " + elf + " 2>&1";
   int status = 0;
   const std::string out = run(cmd, status);
@@ -120,6 +120,16 @@ TEST_CASE("self-test on the Cortex-M4 (QEMU) matches the host build") {
   CHECK(bit_exact);
   MESSAGE("arm levels " << arm.at("level_mid") << " / host " << join(host.level_at_mid)
                         << "; streams bit-exact: " << std::string(bit_exact ? "yes" : "no"));
+
+  // Cost on the Thumb-2 instruction set: with -icount shift=0 every instruction
+  // advances virtual time equally, so SysTick ticks / ticks-per-instruction of a
+  // known 2,000,000-instruction loop counts instructions (a measurement, not a timing).
+  const double ticks_per_instruction = std::stod(arm.at("cost_loop_ticks_per_2M_instructions")) / 2e6;
+  REQUIRE(ticks_per_instruction > 0.0);
+  const double per_frame =
+      std::stod(arm.at("cost_poll_ticks")) / ticks_per_instruction / std::stod(arm.at("cost_frames"));
+  MESSAGE("Cortex-M4 (Thumb-2) instructions per 8-channel frame in Device::poll: " << per_frame);
+  CHECK(per_frame > 100.0);
 
   // The self-test result itself must make sense: pairs 0-1 co-contract in the
   // middle, pairs 2-3 only reciprocally at the end; no fault flags.
