@@ -11,7 +11,7 @@ std::uint64_t DbcSignal::raw(std::span<const std::uint8_t> data) const {
   for (unsigned i = 0; i < length; ++i) {
     const unsigned bit = start_bit + i;
     if (bit / 8 >= data.size()) throw std::out_of_range("signal " + name + " beyond the frame data");
-    v |= static_cast<std::uint64_t>((data[bit / 8] >> (bit % 8)) & 1U) << i;
+    v |= static_cast<std::uint64_t>((static_cast<unsigned>(data[bit / 8]) >> (bit % 8)) & 1U) << i;
   }
   return v;
 }

@@ -6,7 +6,7 @@ namespace {
 
 constexpr std::uint16_t kAllChannels = static_cast<std::uint16_t>((1U << kChannels) - 1U);
 
-bool has(std::uint16_t mask, std::size_t ch) { return ((mask >> ch) & 1U) != 0; }
+bool has(std::uint16_t mask, std::size_t ch) { return ((static_cast<unsigned>(mask) >> ch) & 1U) != 0; }
 
 std::uint16_t whole_pairs(std::uint16_t mask) {
   std::uint16_t out = 0;

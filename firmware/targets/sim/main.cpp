@@ -60,7 +60,7 @@ void write_json(const std::string& path, const Options& opt, const std::string& 
     std::string r = "[";
     bool first = true;
     for (unsigned ch = 0; ch < fw::kChannels; ++ch) {
-      if ((mask >> ch) & 1U) {
+      if ((static_cast<unsigned>(mask) >> ch) & 1U) {
         r += fmt::format("{}{}", first ? "" : ", ", ch);
         first = false;
       }

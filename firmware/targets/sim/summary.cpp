@@ -42,7 +42,7 @@ void Summary::add(const proto::StreamMessage& m, std::uint64_t t_us) {
 std::string channel_list(std::uint16_t mask) {
   std::string s;
   for (std::size_t ch = 0; ch < 16; ++ch) {
-    if (((mask >> ch) & 1U) == 0) continue;
+    if (((static_cast<unsigned>(mask) >> ch) & 1U) == 0) continue;
     if (!s.empty()) s.push_back(',');
     s.append(std::to_string(ch));
   }
