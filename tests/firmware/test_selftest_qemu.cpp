@@ -76,7 +76,8 @@ TEST_CASE("self-test on the Cortex-M4 (QEMU) matches the host build") {
                                                               "cmake --build --preset arm)");
   const std::string usart =
       (std::filesystem::temp_directory_path() / ("tonus-usart-" + std::to_string(::getpid()) + ".bin")).string();
-  const std::string cmd = "timeout 60 " + qemu + " -M netduinoplus2 -nographic -monitor none -icount shift=0 -serial file:" + usart +
+  const std::string cmd = "timeout 60 " + qemu +
+                          " -M netduinoplus2 -nographic -monitor none -icount shift=0 -serial file:" + usart +
                           " -semihosting-config enable=on,target=native -kernel " + elf + " 2>&1";
   int status = 0;
   const std::string out = run(cmd, status);

@@ -95,10 +95,10 @@ SyntheticEmg::SyntheticEmg(const SynthSpec& spec) : spec_(spec), rng_(spec.seed)
 }
 
 FrontEnd SyntheticEmg::front_end() const {
-  FrontEnd fe;  // the band's 12-bit ADC
-  fe.min_rate_hz = 100;
-  fe.max_rate_hz = 4000;
-  fe.rate_step_hz = 1;
+  FrontEnd fe;  // the band's 12-bit ADC, sampled at the generator's one rate
+  fe.min_rate_hz = static_cast<std::uint16_t>(spec_.sample_rate_hz + 0.5F);
+  fe.max_rate_hz = fe.min_rate_hz;
+  fe.rate_step_hz = 0;
   return fe;
 }
 

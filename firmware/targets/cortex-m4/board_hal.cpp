@@ -126,8 +126,11 @@ bool BxCan::init(std::uint8_t node) {
   can1::fs1r.set(1U);
   can1::fm1r.clear(1U);
   can1::ffa1r.clear(1U);
-  can1::f0r1.write(proto::can::make_id(proto::can::Function::request, node) << 21U);
-  can1::f0r2.write((0x7FFU << 21U) | (1U << 2U) | (1U << 1U));  // id, IDE, RTR must match
+  // Every node's REQUEST id (0x600..0x61F) passes: the core's reassembler picks
+  // its own node, so a node id changed by set_config needs no filter update.
+  (void)node;
+  can1::f0r1.write(static_cast<std::uint32_t>(proto::can::Function::request) << 21U);
+  can1::f0r2.write((0x7E0U << 21U) | (1U << 2U) | (1U << 1U));  // function bits, IDE, RTR must match
   can1::fa1r.set(1U);
   can1::fmr.clear(1U);
   can1::mcr.clear(1U);

@@ -3,10 +3,11 @@
 //                  (IN0..IN7); DMA2 stream 0 in double-buffer mode writes each
 //                  half straight into one of two SampleBlocks.
 //   BxCan:         CAN1 on PB8 (RX) / PB9 (TX), 1 Mbit/s, interrupt-driven
-//                  transmit and receive rings, hardware filter on the node's
-//                  REQUEST id, FIFO transmit priority (keeps stream frame order).
+//                  transmit and receive rings, hardware filter on the REQUEST
+//                  function (any node: the core picks its own), FIFO transmit
+//                  priority (keeps the frames of a stream cycle in order).
 //   FlashStorage:  flash sector 1 (16 KiB at 0x08004000).
-//   SysTickClock, Led (PC13, active low), Iwdg (~250 ms), NvicReset.
+//   SysTickClock, Led (PC13, active low), Iwdg (1 s), NvicReset.
 // The USB OTG FS device stack (PA11/PA12) is not written yet: the band
 // streams over CAN only (see firmware/README.md).
 #pragma once

@@ -33,7 +33,6 @@ extern "C" void firmware_main() {
   f405::systick_start();
   g_watchdog.init();
   g_led.init();
-  // The node id is the configured one; the filter is set for it once the core has loaded the config.
   g_can_ok = g_can.init(1);
   static hal::Board board{g_sampler,
                           g_clock,
@@ -47,7 +46,6 @@ extern "C" void firmware_main() {
                           1};
   static fw::Device device(board);
   device.boot();
-  if (g_can_ok && device.config().can_node_id != 1) g_can.init(device.config().can_node_id);
   for (;;) {
     device.poll();
     asm volatile("wfi");  // the next DMA block (1 ms) or CAN frame wakes us

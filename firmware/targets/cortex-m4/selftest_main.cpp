@@ -55,9 +55,9 @@ __attribute__((noinline)) void known_loop() {
 }
 
 void start_systick() {
-  *reinterpret_cast<volatile std::uint32_t*>(0xE000E014) = 0xFFFFFFU;  // LOAD  NOLINT
-  *reinterpret_cast<volatile std::uint32_t*>(0xE000E018) = 0;          // VAL   NOLINT
-  *reinterpret_cast<volatile std::uint32_t*>(0xE000E010) = 0b101;      // processor clock, no IRQ, on  NOLINT
+  *reinterpret_cast<volatile std::uint32_t*>(0xE000E014) = 0xFFFFFFU;           // LOAD  NOLINT
+  *reinterpret_cast<volatile std::uint32_t*>(0xE000E018) = 0;                   // VAL   NOLINT
+  *reinterpret_cast<volatile std::uint32_t*>(0xE000E010) = 0b101;               // processor clock, no IRQ, on  NOLINT
   g_last = *reinterpret_cast<volatile std::uint32_t*>(0xE000E018) & 0xFFFFFFU;  // NOLINT
 }
 
