@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <numeric>
+#include <tuple>
 #include <vector>
 
 #include "emg_recording.hpp"
@@ -195,4 +198,32 @@ TEST_CASE(
     CHECK(art == 0);
     CHECK(sat_false == 0);
   }
+}
+
+TEST_CASE("malformed recordings are refused with the file and line") {
+  const auto path = std::filesystem::temp_directory_path() / "tonus-bad-recording.txt";
+  const auto try_load = [&](const std::string& text) {
+    std::ofstream(path) << text;
+    sim::Recording rec;
+    std::string error;
+    const bool ok = sim::load_recording(path.string(), rec, error);
+    return std::make_pair(ok, error);
+  };
+  auto [ok, error] = try_load("1,2,3\n");
+  CHECK_FALSE(ok);
+  CHECK(error.find(":1:") != std::string::npos);
+  std::tie(ok, error) = try_load("# Sampling Rate (Hz):= 1000.00\n2048\n5000\n");
+  CHECK_FALSE(ok);
+  CHECK(error.find(":3:") != std::string::npos);
+  std::tie(ok, error) = try_load("# no rate header\n2048\n");
+  CHECK_FALSE(ok);
+  CHECK(error.find("Sampling Rate") != std::string::npos);
+  std::tie(ok, error) = try_load("1,2,3,4,5,6,7,300,0\n");
+  CHECK_FALSE(ok);
+  std::tie(ok, error) = try_load("");
+  CHECK_FALSE(ok);
+  std::filesystem::remove(path);
+  sim::Recording rec;
+  CHECK_FALSE(sim::load_recording("/nonexistent/emg.txt", rec, error));
+  CHECK(error.find("cannot open") != std::string::npos);
 }

@@ -1,5 +1,7 @@
 #include "tonus/firmware/device.hpp"
 
+#include <cmath>
+
 #include "tonus/protocol/hid.hpp"
 #include "tonus/protocol/wire.hpp"
 
@@ -16,7 +18,7 @@ std::uint16_t to_q15(float v) {
   const float scaled = v * static_cast<float>(proto::kEnvelopeOne);
   if (!(scaled > 0.0F)) return 0;
   if (scaled >= 65535.0F) return 0xFFFF;
-  return static_cast<std::uint16_t>(scaled + 0.5F);
+  return static_cast<std::uint16_t>(std::lround(scaled));
 }
 
 // Offsets of the enum fields inside the DeviceConfig wire form, to name the

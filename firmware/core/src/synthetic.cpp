@@ -96,7 +96,7 @@ SyntheticEmg::SyntheticEmg(const SynthSpec& spec) : spec_(spec), rng_(spec.seed)
 
 FrontEnd SyntheticEmg::front_end() const {
   FrontEnd fe;  // the band's 12-bit ADC, sampled at the generator's one rate
-  fe.min_rate_hz = static_cast<std::uint16_t>(spec_.sample_rate_hz + 0.5F);
+  fe.min_rate_hz = static_cast<std::uint16_t>(std::lround(spec_.sample_rate_hz));
   fe.max_rate_hz = fe.min_rate_hz;
   fe.rate_step_hz = 0;
   return fe;
@@ -165,7 +165,7 @@ std::size_t SyntheticEmg::generate(std::span<std::int16_t> out, std::size_t fram
     const float t = static_cast<float>(frame_) / spec_.sample_rate_hz;
     for (std::size_t ch = 0; ch < kChannels; ++ch) {
       const float v = clampf(sample(ch, t), 0.0F, 4095.0F);
-      out[n * kChannels + ch] = static_cast<std::int16_t>(v + 0.5F);
+      out[n * kChannels + ch] = static_cast<std::int16_t>(std::lround(v));
     }
   }
   return n;

@@ -1,6 +1,7 @@
 #include "emg_recording.hpp"
 
 #include <charconv>
+#include <cmath>
 #include <fstream>
 #include <string_view>
 
@@ -118,7 +119,7 @@ bool load_recording(const std::string& path, Recording& out, std::string& error)
     return false;
   }
   // The recording's own rate is the only one its "sampler" runs at.
-  const auto rate = static_cast<std::uint16_t>(out.sample_rate_hz + 0.5F);
+  const auto rate = static_cast<std::uint16_t>(std::lround(out.sample_rate_hz));
   out.front_end.min_rate_hz = rate;
   out.front_end.max_rate_hz = rate;
   out.front_end.rate_step_hz = 0;

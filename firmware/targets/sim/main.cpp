@@ -259,5 +259,10 @@ int main(int argc, char** argv) {
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  return run(opt);
+  try {
+    return run(opt);
+  } catch (const std::exception& e) {  // e.g. an unwritable --json path
+    fmt::print(stderr, "tonus-band-sim: {}\n", e.what());
+    return 1;
+  }
 }

@@ -5,8 +5,9 @@
 // the bulk of the surface-EMG spectrum) scaled by activation(t) * mvc_rms,
 // plus an electrode/amplifier noise floor, mains hum, a DC offset near
 // mid-scale, quantised to a 12-bit ADC (clipped at its rails). Scenarios add
-// scripted faults. Freestanding (no heap, no libm in the sample loop), so the
-// Cortex-M4 self-test generates bit-identical input to the host build.
+// scripted faults. Freestanding (no heap; no transcendental libm calls in the
+// sample loop, only exact ones such as lround), so the Cortex-M4 self-test
+// generates bit-identical input to the host build.
 #pragma once
 
 #include <array>
