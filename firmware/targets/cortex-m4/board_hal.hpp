@@ -8,8 +8,7 @@
 //                  priority (keeps the frames of a stream cycle in order).
 //   FlashStorage:  flash sector 1 (16 KiB at 0x08004000).
 //   SysTickClock, Led (PC13, active low), Iwdg (1 s), NvicReset.
-// The USB OTG FS device stack (PA11/PA12) is not written yet: the band
-// streams over CAN only (see firmware/README.md).
+// USB-HID is usb::DeviceCore over the OTG FS driver in otg_fs_dcd.hpp.
 #pragma once
 
 #include <array>

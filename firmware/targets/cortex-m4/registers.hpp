@@ -41,6 +41,7 @@ inline void priority(unsigned irq, std::uint8_t prio) {
 inline constexpr unsigned kIrqCan1Tx = 19;
 inline constexpr unsigned kIrqCan1Rx0 = 20;
 inline constexpr unsigned kIrqDma2Stream0 = 56;
+inline constexpr unsigned kIrqOtgFs = 67;
 
 namespace rcc {
 inline constexpr std::uint32_t kBase = 0x40023800;
@@ -48,6 +49,7 @@ inline constexpr Reg cr = at(kBase, 0x00);
 inline constexpr Reg pllcfgr = at(kBase, 0x04);
 inline constexpr Reg cfgr = at(kBase, 0x08);
 inline constexpr Reg ahb1enr = at(kBase, 0x30);
+inline constexpr Reg ahb2enr = at(kBase, 0x34);
 inline constexpr Reg apb1enr = at(kBase, 0x40);
 inline constexpr Reg apb2enr = at(kBase, 0x44);
 inline constexpr Reg csr = at(kBase, 0x74);
@@ -143,6 +145,36 @@ inline constexpr Reg fa1r = at(kBase, 0x21C);
 inline constexpr Reg f0r1 = at(kBase, 0x240);
 inline constexpr Reg f0r2 = at(kBase, 0x244);
 }  // namespace can1
+
+// USB OTG full-speed core (RM0090 section 34.16), device mode.
+namespace otg {
+inline constexpr std::uint32_t kBase = 0x50000000;
+inline constexpr Reg gahbcfg = at(kBase, 0x008);
+inline constexpr Reg gusbcfg = at(kBase, 0x00C);
+inline constexpr Reg grstctl = at(kBase, 0x010);
+inline constexpr Reg gintsts = at(kBase, 0x014);
+inline constexpr Reg gintmsk = at(kBase, 0x018);
+inline constexpr Reg grxstsp = at(kBase, 0x020);
+inline constexpr Reg grxfsiz = at(kBase, 0x024);
+inline constexpr Reg dieptxf0 = at(kBase, 0x028);
+inline constexpr Reg gccfg = at(kBase, 0x038);
+inline constexpr Reg dieptxf1 = at(kBase, 0x104);
+inline constexpr Reg dcfg = at(kBase, 0x800);
+inline constexpr Reg dctl = at(kBase, 0x804);
+inline constexpr Reg diepmsk = at(kBase, 0x810);
+inline constexpr Reg doepmsk = at(kBase, 0x814);
+inline constexpr Reg daint = at(kBase, 0x818);
+inline constexpr Reg daintmsk = at(kBase, 0x81C);
+inline constexpr Reg pcgcctl = at(kBase, 0xE00);
+inline constexpr Reg diepctl(unsigned ep) { return at(kBase, 0x900 + 0x20 * ep); }
+inline constexpr Reg diepint(unsigned ep) { return at(kBase, 0x908 + 0x20 * ep); }
+inline constexpr Reg dieptsiz(unsigned ep) { return at(kBase, 0x910 + 0x20 * ep); }
+inline constexpr Reg dtxfsts(unsigned ep) { return at(kBase, 0x918 + 0x20 * ep); }
+inline constexpr Reg doepctl(unsigned ep) { return at(kBase, 0xB00 + 0x20 * ep); }
+inline constexpr Reg doepint(unsigned ep) { return at(kBase, 0xB08 + 0x20 * ep); }
+inline constexpr Reg doeptsiz(unsigned ep) { return at(kBase, 0xB10 + 0x20 * ep); }
+inline constexpr Reg fifo(unsigned ep) { return at(kBase, 0x1000 + 0x1000 * ep); }
+}  // namespace otg
 
 namespace iwdg {
 inline constexpr std::uint32_t kBase = 0x40003000;

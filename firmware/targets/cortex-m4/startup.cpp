@@ -28,6 +28,7 @@ void SysTick_Handler() __attribute__((weak, alias("Default_Handler")));
 void CAN1_TX_IRQHandler() __attribute__((weak, alias("Default_Handler")));
 void CAN1_RX0_IRQHandler() __attribute__((weak, alias("Default_Handler")));
 void DMA2_Stream0_IRQHandler() __attribute__((weak, alias("Default_Handler")));
+void OTG_FS_IRQHandler() __attribute__((weak, alias("Default_Handler")));
 
 // A pure virtual call is a bug; stop here rather than pull in libsupc++'s
 // terminate machinery (which would allocate).
@@ -65,6 +66,7 @@ constexpr VectorTable make_table() {
   t.irq[tonus::f405::kIrqCan1Tx] = CAN1_TX_IRQHandler;
   t.irq[tonus::f405::kIrqCan1Rx0] = CAN1_RX0_IRQHandler;
   t.irq[tonus::f405::kIrqDma2Stream0] = DMA2_Stream0_IRQHandler;
+  t.irq[tonus::f405::kIrqOtgFs] = OTG_FS_IRQHandler;
   return t;
 }
 
