@@ -253,6 +253,27 @@ TEST_CASE("a lost block is counted and flagged once; a repeated block is never p
   CHECK(dev.stats().lost_blocks == 3);
 }
 
+TEST_CASE("a block processed long after it was sampled is counted late, and still processed once") {
+  Bench b(spec(Scenario::rest, 2.0F));
+  hal::Board board = b.board();
+  Device dev(board);
+  dev.boot();
+  b.run_for(dev, 0.1F);
+  CHECK(dev.stats().late_blocks == 0);
+  const std::uint32_t reports = dev.reports();
+  // The main loop stalled for 10 ms (e.g. a flash erase): the next block is old news.
+  hal::SampleBlock late{};
+  late.sequence = b.sequence++;
+  late.frames = 2;
+  late.first_sample_us = b.clock.now_us();
+  b.clock.advance_to(late.first_sample_us + 10000);
+  b.sampler.push(late);
+  dev.poll();
+  CHECK(dev.stats().late_blocks == 1);
+  CHECK(dev.stats().lost_blocks == 0);
+  CHECK(dev.reports() == reports + 1);
+}
+
 TEST_CASE("scripted faults raise their flags on their channels, at their times") {
   const float T = 10.0F;
   Bench b(spec(Scenario::faults, T));
