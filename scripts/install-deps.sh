@@ -16,6 +16,8 @@ packages=(
   libmujoco-dev
   # tools used by tests and benchmarks
   can-utils valgrind python3
+  # emulator for the firmware self-test (STM32F405 = machine netduinoplus2)
+  qemu-system-arm
 )
 
 missing=()

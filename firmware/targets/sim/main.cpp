@@ -1,0 +1,268 @@
+// tonus-band-sim: the band's firmware core on Linux, the hardware-in-loop stub
+// for tests and for the host daemon. See firmware/README.md.
+#include <fmt/core.h>
+#include <fmt/os.h>
+#include <CLI/CLI.hpp>
+
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <thread>
+
+#include "emg_recording.hpp"
+#include "sim_hal.hpp"
+#include "summary.hpp"
+#include "tonus/firmware/device.hpp"
+#include "tonus/protocol/sequence.hpp"
+
+namespace {
+
+using namespace tonus;
+
+volatile std::sig_atomic_t g_stop = 0;
+void on_signal(int) { g_stop = 1; }
+
+struct Options {
+  std::string synthetic;
+  std::string recording;
+  double seconds = 0.0;
+  std::uint64_t seed = 1;
+  unsigned sample_rate_hz = 2000;
+  unsigned mains_hz = 50;
+  bool fast = false;
+  std::string json;
+  std::string candump;
+  std::string hid_socket, can_socket;
+  int hid_fd = -1, can_fd = -1;
+  std::string storage;
+  bool quiet = false;
+};
+
+struct Observer {
+  sim::Summary summary;
+  proto::TimestampUnwrapper clock;
+  static void on_report(void* self, const proto::StreamMessage& m) {
+    auto* o = static_cast<Observer*>(self);
+    o->summary.add(m, static_cast<std::uint64_t>(o->clock.push(m.device_time_us)));
+  }
+};
+
+void write_json(const std::string& path, const Options& opt, const std::string& source, double seconds,
+                const fw::Device& dev, const sim::Summary& s, const fw::ChainDelay& delay) {
+  auto out = fmt::output_file(path);
+  const proto::DeviceStats st = dev.stats();
+  const auto list = [](auto values) {
+    std::string r = "[";
+    for (std::size_t k = 0; k < values.size(); ++k) r += (k ? ", " : "") + fmt::format("{}", values[k]);
+    return r + "]";
+  };
+  const auto channels = [](std::uint16_t mask) {
+    std::string r = "[";
+    bool first = true;
+    for (unsigned ch = 0; ch < fw::kChannels; ++ch) {
+      if ((static_cast<unsigned>(mask) >> ch) & 1U) {
+        r += fmt::format("{}{}", first ? "" : ", ", ch);
+        first = false;
+      }
+    }
+    return r + "]";
+  };
+  std::array<double, fw::kGroups> mean{};
+  for (std::size_t g = 0; g < fw::kGroups; ++g) {
+    mean[g] = s.reports ? s.levels_sum[g] / static_cast<double>(s.reports) : 0.0;
+  }
+  const std::array<std::uint16_t, fw::kGroups> no_reports{};
+  out.print("{{\n");
+  out.print("  \"source\": \"{}\",\n  \"seed\": {},\n  \"seconds\": {:.3f},\n", source, opt.seed, seconds);
+  out.print("  \"sample_rate_hz\": {},\n  \"report_rate_hz\": {},\n", dev.config().sample_rate_hz,
+            dev.config().report_rate_hz);
+  out.print("  \"reports\": {},\n  \"sequence_continuous\": {},\n", s.reports, s.sequence_continuous);
+  out.print("  \"lost_blocks\": {},\n  \"late_blocks\": {},\n  \"stale_blocks\": {},\n  \"tx_dropped\": {},\n",
+            st.lost_blocks, st.late_blocks, dev.stale_blocks(), st.tx_dropped);
+  out.print("  \"levels_min\": {},\n  \"levels_max\": {},\n", list(s.reports ? s.levels_min : no_reports),
+            list(s.levels_max));
+  out.print("  \"levels_mean\": {},\n", list(mean));
+  out.print("  \"flags_seen\": {{\"electrode_off\": {}, \"saturation\": {}, \"artifact\": {}, \"block_lost\": {}}},\n",
+            channels(s.electrode_off), channels(s.saturation), channels(s.artifact), s.block_lost_reports > 0);
+  out.print(
+      "  \"first_flag_s\": {{\"electrode_off\": {}, \"saturation\": {}, \"artifact\": {}, \"block_lost\": {:.4f}}},\n",
+      list(s.first_off_s), list(s.first_saturation_s), list(s.first_artifact_s), s.first_block_lost_s);
+  out.print("  \"status_seen\": {},\n", s.status_seen);
+  out.print("  \"group_delay_ms\": {{\"filters\": {:.3f}, \"envelope\": {:.3f}, \"total\": {:.3f}}}\n",
+            delay.filters_s * 1e3, delay.envelope_s * 1e3, delay.total_s() * 1e3);
+  out.print("}}\n");
+}
+
+int run(const Options& opt) {
+  std::unique_ptr<sim::FrameSource> source;
+  std::string source_name;
+  if (!opt.recording.empty()) {
+    sim::Recording rec;
+    std::string error;
+    if (!sim::load_recording(opt.recording, rec, error)) {
+      fmt::print(stderr, "tonus-band-sim: {}\n", error);
+      return 2;
+    }
+    if (opt.seconds > 0.0) {
+      const auto n = static_cast<std::size_t>(opt.seconds * static_cast<double>(rec.sample_rate_hz));
+      if (n < rec.frames.size()) rec.frames.resize(n);
+    }
+    source_name = fmt::format("recording {} ({}, {} Hz)", opt.recording, rec.format, rec.sample_rate_hz);
+    source = sim::make_recording_source(std::move(rec));
+  } else {
+    fw::SynthSpec spec;
+    if (!fw::parse_scenario(opt.synthetic.c_str(), spec.scenario)) {
+      fmt::print(stderr, "tonus-band-sim: unknown scenario '{}' (rest, ramp, faults, bursts, hum, dropout, selftest)\n",
+                 opt.synthetic);
+      return 2;
+    }
+    spec.seed = opt.seed;
+    spec.sample_rate_hz = static_cast<float>(opt.sample_rate_hz);
+    spec.seconds = static_cast<float>(opt.seconds);
+    spec.mains_hz = static_cast<float>(opt.mains_hz);
+    source_name = fmt::format("synthetic {}", opt.synthetic);
+    source = sim::make_synthetic_source(spec);
+  }
+
+  std::FILE* candump = nullptr;
+  if (!opt.candump.empty()) {
+    candump = std::fopen(opt.candump.c_str(), "w");
+    if (candump == nullptr) {
+      fmt::print(stderr, "tonus-band-sim: cannot write {}\n", opt.candump);
+      return 2;
+    }
+  }
+
+  sim::SimClock clock(!opt.fast);
+  // 1 ms blocks as on the band (2 frames at 2 kHz), at least one frame.
+  const auto block_frames = std::max<std::size_t>(1, static_cast<std::size_t>(source->sample_rate_hz() / 1000.0F));
+  sim::SimSampler sampler(*source, clock, block_frames);
+  sim::FlashStorage storage(opt.storage);
+  sim::SimLed led;
+  sim::SimWatchdog watchdog;
+  sim::SimSystem system;
+
+  sim::SeqpacketEndpoint hid_ep, can_ep;
+  std::unique_ptr<sim::SeqpacketHid> hid;
+  std::unique_ptr<sim::SeqpacketCan> seam_can;
+  std::unique_ptr<sim::LogOnlyCan> log_can;
+  hal::CanPort* can = nullptr;
+  std::string error;
+  if (opt.hid_fd >= 0 || !opt.hid_socket.empty()) {
+    const bool ok = opt.hid_fd >= 0 ? hid_ep.adopt_fd(opt.hid_fd, error) : hid_ep.listen_on(opt.hid_socket, error);
+    if (!ok) {
+      fmt::print(stderr, "tonus-band-sim: HID link: {}\n", error);
+      return 2;
+    }
+    hid_ep.set_blocking_send(opt.fast);
+    hid = std::make_unique<sim::SeqpacketHid>(hid_ep);
+  }
+  if (opt.can_fd >= 0 || !opt.can_socket.empty()) {
+    const bool ok = opt.can_fd >= 0 ? can_ep.adopt_fd(opt.can_fd, error) : can_ep.listen_on(opt.can_socket, error);
+    if (!ok) {
+      fmt::print(stderr, "tonus-band-sim: CAN link: {}\n", error);
+      return 2;
+    }
+    can_ep.set_blocking_send(opt.fast);
+    seam_can = std::make_unique<sim::SeqpacketCan>(can_ep, clock, candump);
+    can = seam_can.get();
+  } else if (candump != nullptr) {
+    log_can = std::make_unique<sim::LogOnlyCan>(clock, candump);
+    can = log_can.get();
+  }
+
+  hal::Board board{sampler, clock, storage, led, watchdog, system, hid.get(), can, 0x7090000000000001ULL, 1};
+  static fw::Device device(board);  // static: ~10 KiB of state, as on the band
+  Observer observer;
+  device.set_report_observer(&Observer::on_report, &observer);
+  device.boot();
+  if (device.boot_load_result() != fw::LoadResult::loaded && !opt.storage.empty() && !opt.quiet) {
+    fmt::print(stderr, "tonus-band-sim: storage {}: {}, using defaults\n", opt.storage,
+               fw::to_string(device.boot_load_result()));
+  }
+  if (device.config().sample_rate_hz != static_cast<std::uint16_t>(source->sample_rate_hz())) {
+    fmt::print(stderr, "tonus-band-sim: the stored configuration asks for {} Hz, the source runs at {} Hz\n",
+               device.config().sample_rate_hz, source->sample_rate_hz());
+  }
+
+  const auto wall_start = std::chrono::steady_clock::now();
+  bool more = true;
+  while (more && g_stop == 0) {
+    if (!opt.fast) std::this_thread::sleep_until(wall_start + std::chrono::microseconds(sampler.next_block_start_us()));
+    more = sampler.produce();
+    device.poll();
+    if (system.take_reset()) device.boot();  // what the band does after NVIC_SystemReset
+    // A host that connected over an inherited fd and went away ends the run.
+    if ((opt.hid_fd >= 0 && hid_ep.peer_gone()) || (opt.can_fd >= 0 && can_ep.peer_gone())) {
+      if (!opt.quiet) fmt::print(stderr, "tonus-band-sim: host closed the link, stopping\n");
+      break;
+    }
+  }
+  device.poll();  // answer commands that came with the last block
+  if (candump != nullptr) std::fclose(candump);
+
+  const double seconds = static_cast<double>(sampler.frames_done()) / static_cast<double>(source->sample_rate_hz());
+  const sim::Summary& s = observer.summary;
+  const fw::ChainDelay delay = fw::chain_group_delay(device.chain());
+  const proto::DeviceStats st = device.stats();
+  if (!opt.quiet) {
+    fmt::print("tonus-band-sim: {}, {:.2f} s at {} Hz, reports at {} Hz\n", source_name, seconds,
+               device.config().sample_rate_hz, device.config().report_rate_hz);
+    fmt::print("  reports {}  lost blocks {}  late blocks {}  tx dropped {}  sequence {}\n", s.reports, st.lost_blocks,
+               st.late_blocks, st.tx_dropped, s.sequence_continuous ? "continuous" : "GAPS");
+    for (std::size_t g = 0; g < fw::kGroups; ++g) {
+      fmt::print("  group {}: level min {:5}  max {:5}  mean {:8.1f}\n", g, s.reports ? s.levels_min[g] : 0,
+                 s.levels_max[g], s.reports ? s.levels_sum[g] / static_cast<double>(s.reports) : 0.0);
+    }
+    fmt::print("  flags: electrode_off [{}]  saturation [{}]  artifact [{}]  block_lost {}\n",
+               sim::channel_list(s.electrode_off), sim::channel_list(s.saturation), sim::channel_list(s.artifact),
+               s.block_lost_reports > 0 ? "yes" : "no");
+    fmt::print("  chain group delay: filters {:.2f} ms at {:.0f} Hz + envelope {:.2f} ms = {:.2f} ms\n",
+               delay.filters_s * 1e3, fw::kReferenceEmgHz, delay.envelope_s * 1e3, delay.total_s() * 1e3);
+  }
+  if (!opt.json.empty()) write_json(opt.json, opt, source_name, seconds, device, s, delay);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"tonus-band-sim: the band firmware core on Linux (synthetic EMG or a recording)"};
+  Options opt;
+  auto* synth =
+      app.add_option("--synthetic", opt.synthetic, "scenario: rest, ramp, faults, bursts, hum, dropout, selftest");
+  auto* rec =
+      app.add_option("--recording", opt.recording, "EMG recording (BioSPPy text or Myo CSV)")->check(CLI::ExistingFile);
+  synth->excludes(rec);
+  app.add_option("--seconds", opt.seconds, "duration (synthetic) or maximum length (recording)")
+      ->check(CLI::Range(0.0, 86400.0));
+  app.add_option("--seed", opt.seed, "seed of the synthetic generator");
+  app.add_option("--sample-rate", opt.sample_rate_hz, "synthetic sample rate, Hz")->check(CLI::Range(100, 4000));
+  app.add_option("--mains", opt.mains_hz, "synthetic mains frequency, Hz")->check(CLI::IsMember({50, 60}));
+  app.add_flag("--fast", opt.fast, "run as fast as possible (virtual clock) instead of real time");
+  app.add_option("--json", opt.json, "write a JSON summary to FILE");
+  app.add_option("--candump", opt.candump, "log every CAN frame in candump -l format to FILE");
+  app.add_option("--hid-socket", opt.hid_socket, "serve the HID link on a SOCK_SEQPACKET socket at PATH");
+  app.add_option("--hid-fd", opt.hid_fd, "serve the HID link on an inherited connected SOCK_SEQPACKET fd");
+  app.add_option("--can-socket", opt.can_socket, "serve the CAN link on a SOCK_SEQPACKET socket at PATH");
+  app.add_option("--can-fd", opt.can_fd, "serve the CAN link on an inherited connected SOCK_SEQPACKET fd");
+  app.add_option("--storage", opt.storage, "file backing the simulated flash (config and calibration)");
+  app.add_flag("--quiet", opt.quiet, "no summary on stdout");
+  CLI11_PARSE(app, argc, argv);
+  if (opt.synthetic.empty() && opt.recording.empty()) {
+    fmt::print(stderr, "tonus-band-sim: give --synthetic NAME or --recording FILE\n");
+    return 2;
+  }
+  if (!opt.synthetic.empty() && !(opt.seconds > 0.0)) {
+    fmt::print(stderr, "tonus-band-sim: --synthetic needs --seconds > 0\n");
+    return 2;
+  }
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  try {
+    return run(opt);
+  } catch (const std::exception& e) {  // e.g. an unwritable --json path
+    fmt::print(stderr, "tonus-band-sim: {}\n", e.what());
+    return 1;
+  }
+}

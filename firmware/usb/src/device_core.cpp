@@ -1,0 +1,212 @@
+#include "tonus/usb/device_core.hpp"
+
+namespace tonus::usb {
+
+namespace {
+
+// bmRequestType fields (USB 2.0 table 9-2)
+constexpr std::uint8_t kDirIn = 0x80;
+constexpr std::uint8_t kTypeMask = 0x60, kTypeStandard = 0x00, kTypeClass = 0x20;
+constexpr std::uint8_t kRecipientMask = 0x1F, kRecipientDevice = 0, kRecipientInterface = 1, kRecipientEndpoint = 2;
+
+// Standard requests (table 9-4)
+constexpr std::uint8_t kGetStatus = 0, kClearFeature = 1, kSetFeature = 3, kSetAddress = 5, kGetDescriptor = 6,
+                       kGetConfiguration = 8, kSetConfiguration = 9, kGetInterface = 10, kSetInterface = 11;
+// HID class requests (HID 1.11 section 7.2)
+constexpr std::uint8_t kGetReport = 1, kGetIdle = 2, kGetProtocol = 3, kSetReport = 9, kSetIdle = 10, kSetProtocol = 11;
+constexpr std::uint8_t kReportTypeOutput = 2;
+
+std::uint16_t le16(std::uint8_t lo, std::uint8_t hi) { return static_cast<std::uint16_t>(lo | (hi << 8U)); }
+
+}  // namespace
+
+SetupPacket SetupPacket::parse(std::span<const std::uint8_t, 8> raw) {
+  return {raw[0], raw[1], le16(raw[2], raw[3]), le16(raw[4], raw[5]), le16(raw[6], raw[7])};
+}
+
+void DeviceCore::on_bus_reset() {
+  configured_.store(false);
+  address_ = 0;
+  configuration_ = 0;
+  set_report_pending_ = false;
+  dcd_.configure_hid_endpoints(false);
+}
+
+void DeviceCore::reply(std::span<const std::uint8_t> data, std::uint16_t requested) {
+  // Never more than the host asked for; a short reply that fills whole packets
+  // needs a zero-length packet so the host knows it ended.
+  const std::size_t n = data.size() < requested ? data.size() : requested;
+  const bool zlp = n < requested && n % kEp0Size == 0;
+  dcd_.ep0_send(data.first(n), zlp);
+}
+
+void DeviceCore::on_setup(std::span<const std::uint8_t, 8> raw) {
+  const SetupPacket s = SetupPacket::parse(raw);
+  set_report_pending_ = false;
+  switch (s.request_type & kTypeMask) {
+    case kTypeStandard: standard_request(s); return;
+    case kTypeClass: class_request(s); return;
+    default: dcd_.ep0_stall(); return;
+  }
+}
+
+void DeviceCore::get_descriptor(const SetupPacket& s) {
+  const auto type = static_cast<std::uint8_t>(s.value >> 8U);
+  const auto index = static_cast<std::uint8_t>(s.value & 0xFFU);
+  switch (type) {
+    case desc::device: reply(kDeviceDescriptor, s.length); return;
+    case desc::configuration:
+      if (index != 0) break;
+      reply(kConfigurationDescriptor, s.length);
+      return;
+    case desc::string: {
+      const std::size_t n = string_descriptor(index, serial_, ep0_buffer_);
+      if (n == 0) break;
+      reply(std::span<const std::uint8_t>(ep0_buffer_).first(n), s.length);
+      return;
+    }
+    case desc::hid_report:
+      if ((s.request_type & kRecipientMask) != kRecipientInterface || s.index != 0) break;
+      reply(proto::hid::kReportDescriptor, s.length);
+      return;
+    case desc::hid:
+      if ((s.request_type & kRecipientMask) != kRecipientInterface || s.index != 0) break;
+      reply(std::span<const std::uint8_t>(kConfigurationDescriptor).subspan(18, 9), s.length);
+      return;
+    default: break;
+  }
+  dcd_.ep0_stall();  // e.g. device qualifier: a full-speed-only device stalls it
+}
+
+void DeviceCore::standard_request(const SetupPacket& s) {
+  const std::uint8_t recipient = s.request_type & kRecipientMask;
+  switch (s.request) {
+    case kGetDescriptor: get_descriptor(s); return;
+    case kSetAddress:
+      if (recipient != kRecipientDevice || s.value > 127) break;
+      address_ = static_cast<std::uint8_t>(s.value);
+      dcd_.set_address(address_);
+      dcd_.ep0_status();
+      return;
+    case kSetConfiguration:
+      if (recipient != kRecipientDevice || s.value > 1) break;
+      configuration_ = static_cast<std::uint8_t>(s.value);
+      dcd_.configure_hid_endpoints(configuration_ == 1);
+      configured_.store(configuration_ == 1);
+      dcd_.ep0_status();
+      return;
+    case kGetConfiguration:
+      ep0_buffer_[0] = configuration_;
+      reply(std::span<const std::uint8_t>(ep0_buffer_).first(1), s.length);
+      return;
+    case kGetStatus:
+      ep0_buffer_[0] = 0;  // bus powered, no remote wake-up, endpoint not halted
+      ep0_buffer_[1] = 0;
+      reply(std::span<const std::uint8_t>(ep0_buffer_).first(2), s.length);
+      return;
+    case kClearFeature:
+    case kSetFeature:
+      // ENDPOINT_HALT on EP1 is accepted (the interrupt endpoints never halt by themselves).
+      if (recipient == kRecipientEndpoint || recipient == kRecipientDevice) {
+        dcd_.ep0_status();
+        return;
+      }
+      break;
+    case kGetInterface:
+      if (recipient != kRecipientInterface || configuration_ == 0) break;
+      ep0_buffer_[0] = 0;
+      reply(std::span<const std::uint8_t>(ep0_buffer_).first(1), s.length);
+      return;
+    case kSetInterface:
+      if (recipient != kRecipientInterface || s.value != 0) break;
+      dcd_.ep0_status();
+      return;
+    default: break;
+  }
+  dcd_.ep0_stall();
+}
+
+void DeviceCore::class_request(const SetupPacket& s) {
+  if ((s.request_type & kRecipientMask) != kRecipientInterface || s.index != 0) {
+    dcd_.ep0_stall();
+    return;
+  }
+  switch (s.request) {
+    case kSetIdle:
+      idle_rate_ = static_cast<std::uint8_t>(s.value >> 8U);
+      dcd_.ep0_status();
+      return;
+    case kGetIdle:
+      ep0_buffer_[0] = idle_rate_;
+      reply(std::span<const std::uint8_t>(ep0_buffer_).first(1), s.length);
+      return;
+    case kSetProtocol:
+      protocol_ = static_cast<std::uint8_t>(s.value & 1U);
+      dcd_.ep0_status();
+      return;
+    case kGetProtocol:
+      ep0_buffer_[0] = protocol_;
+      reply(std::span<const std::uint8_t>(ep0_buffer_).first(1), s.length);
+      return;
+    case kGetReport: {
+      // Input reports travel on EP1; polled over EP0 they read as empty (id + zeros).
+      ep0_buffer_.fill(0);
+      ep0_buffer_[0] = static_cast<std::uint8_t>(s.value & 0xFFU);
+      reply(std::span<const std::uint8_t>(ep0_buffer_).first(proto::hid::kReportSize), s.length);
+      return;
+    }
+    case kSetReport:
+      // An output report sent through the control pipe (hidraw without an OUT endpoint).
+      if ((s.value >> 8U) != kReportTypeOutput || s.length == 0 || s.length > proto::hid::kReportSize ||
+          (s.request_type & kDirIn) != 0) {
+        break;
+      }
+      set_report_pending_ = true;
+      dcd_.ep0_receive(s.length);
+      return;
+    default: break;
+  }
+  dcd_.ep0_stall();
+}
+
+void DeviceCore::on_ep0_data(std::span<const std::uint8_t> data) {
+  if (!set_report_pending_) return;
+  set_report_pending_ = false;
+  queue_output(data);
+  dcd_.ep0_status();
+}
+
+void DeviceCore::on_hid_out(std::span<const std::uint8_t> packet) { queue_output(packet); }
+
+void DeviceCore::queue_output(std::span<const std::uint8_t> bytes) {
+  const std::size_t head = out_head_.load(std::memory_order_relaxed);
+  const std::size_t next = (head + 1) % kOutQueue;
+  if (next == out_tail_.load(std::memory_order_acquire)) {
+    ++out_overflows_;  // the main loop is not draining commands: drop the newest
+    return;
+  }
+  OutReport& slot = out_[head];
+  slot.bytes.fill(0);
+  slot.length = bytes.size() < slot.bytes.size() ? bytes.size() : slot.bytes.size();
+  for (std::size_t k = 0; k < slot.length; ++k) slot.bytes[k] = bytes[k];
+  out_head_.store(next, std::memory_order_release);
+}
+
+bool DeviceCore::receive_output(proto::hid::Report& report, std::size_t& length) {
+  const std::size_t tail = out_tail_.load(std::memory_order_relaxed);
+  if (tail == out_head_.load(std::memory_order_acquire)) return false;
+  report = out_[tail].bytes;
+  length = out_[tail].length;
+  out_tail_.store((tail + 1) % kOutQueue, std::memory_order_release);
+  return true;
+}
+
+bool DeviceCore::send_input(const proto::hid::Report& report) {
+  if (!configured_.load()) return false;
+  // The DCD refuses while the previous packet is still in flight (the host
+  // polls EP1 every 1 ms); it copies an accepted packet before returning.
+  static_assert(proto::hid::kReportSize == kHidPacket);
+  return dcd_.hid_send(report);
+}
+
+}  // namespace tonus::usb
