@@ -57,7 +57,7 @@ class NullHal final : public hal::EmgSampler,
   void reset() override {}
   [[nodiscard]] bool connected() const override { return true; }
   bool send_input(const proto::hid::Report& r) override {
-    g_sink = g_sink + r[20];
+    g_sink = g_sink + static_cast<float>(r[20]);
     return true;
   }
   bool receive_output(proto::hid::Report&, std::size_t&) override { return false; }

@@ -49,7 +49,8 @@ TEST_CASE("4th-order Butterworth low-pass matches 1/sqrt(1+Omega^8)") {
   for (double fs : {1000.0, 2000.0, 4000.0}) {
     const double fc = 450.0 < 0.45 * fs ? 450.0 : 0.3 * fs;
     const Biquad s[2] = {design_lowpass(fs, fc, butterworth_q(4, 0)), design_lowpass(fs, fc, butterworth_q(4, 1))};
-    for (double f = 5.0; f < 0.49 * fs; f += fs / 97.0) {
+    for (int k = 0; 5.0 + k * fs / 97.0 < 0.49 * fs; ++k) {
+      const double f = 5.0 + k * fs / 97.0;
       const double w = omega(f, fc, fs);
       const double expected = 1.0 / std::sqrt(1.0 + std::pow(w, 8.0));
       const double got = magnitude(s[0], f, fs) * magnitude(s[1], f, fs);

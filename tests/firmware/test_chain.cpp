@@ -124,7 +124,8 @@ TEST_CASE("the envelope of a synthetic EMG recovers its known activation") {
   const ChainModel m = design_chain(config_at(2000));
   const Biquad shp = design_highpass(fs, 40.0, 0.7071), slp = design_lowpass(fs, 200.0, 0.7071);
   double emg_num = 0.0, emg_den = 0.0, noise_num = 0.0, noise_den = 0.0;
-  for (double f = 0.25; f < fs / 2.0; f += 0.25) {
+  for (int k = 1; 0.25 * k < fs / 2.0; ++k) {
+    const double f = 0.25 * k;
     const double shape = magnitude(shp, f, fs) * magnitude(slp, f, fs);
     const double h = chain_magnitude(m, f);
     emg_num += shape * shape * h * h;

@@ -93,7 +93,8 @@ TEST_CASE("BioSPPy 1 kHz: rest and activity separate clearly in the envelope; re
       const QualityFlags& f = r.flags[k][0];
       flagged = flagged || f.electrode_off || f.saturation || f.artifact;
     }
-    env /= static_cast<double>(w / 2);
+    const std::size_t tail = w - w / 2;  // frames summed above
+    env /= static_cast<double>(tail);
     if (sd < 15.0) {
       rest_env.push_back(env);
       ++rest_windows;

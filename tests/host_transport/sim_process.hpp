@@ -31,6 +31,7 @@ class SimProcess {
     std::vector<std::string> argv_s{TONUS_BAND_SIM};
     argv_s.insert(argv_s.end(), args.begin(), args.end());
     std::vector<char*> argv;
+    argv.reserve(argv_s.size() + 1);
     for (auto& s : argv_s) argv.push_back(s.data());
     argv.push_back(nullptr);
     ok_ = posix_spawn(&pid_, TONUS_BAND_SIM, &fa, nullptr, argv.data(), environ) == 0;

@@ -224,9 +224,7 @@ int run(const Options& opt) {
   return 0;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int cli_main(int argc, char** argv) {
   CLI::App app{"tonus-band-sim: the band firmware core on Linux (synthetic EMG or a recording)"};
   Options opt;
   auto* synth =
@@ -259,10 +257,20 @@ int main(int argc, char** argv) {
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
+  return run(opt);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
   try {
-    return run(opt);
+    return cli_main(argc, argv);
   } catch (const std::exception& e) {  // e.g. an unwritable --json path
-    fmt::print(stderr, "tonus-band-sim: {}\n", e.what());
-    return 1;
+    std::fputs("tonus-band-sim: ", stderr);
+    std::fputs(e.what(), stderr);
+    std::fputs("\n", stderr);
+  } catch (...) {
+    std::fputs("tonus-band-sim: unknown error\n", stderr);
   }
+  return 1;
 }

@@ -81,7 +81,7 @@ class SimSampler final : public hal::EmgSampler {
 
 class FlashStorage final : public hal::Storage {
  public:
-  static constexpr std::size_t kSize = 16 * 1024;  // one STM32F405 sector 1
+  static constexpr std::size_t kSize = std::size_t{16} * 1024;  // one STM32F405 sector 1
   explicit FlashStorage(std::string path = {});
   [[nodiscard]] std::size_t size() const override { return bytes_.size(); }
   bool read(std::size_t offset, std::span<std::uint8_t> out) override;
