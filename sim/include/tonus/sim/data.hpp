@@ -1,0 +1,187 @@
+// The mutable half of the Model/Data split: the state of one simulation and
+// every scratch array the step needs, sized at compile time. make_data()
+// allocates it once; step() then never allocates.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+
+#include "tonus/sim/capacity.hpp"
+#include "tonus/sim/collision.hpp"
+#include "tonus/sim/model.hpp"
+
+namespace tonus::sim {
+
+// How the articulation's root moves (per Data, so simulation A and B of the
+// dual scheme can differ):
+//  fixed      the root stays where it is;
+//  kinematic  the root follows StepInputs' root reference exactly, the rest is simulated;
+//  free       the root is simulated (optionally helped by the root servo).
+enum class RootMode : std::uint8_t { fixed, kinematic, free };
+
+// A free rigid sphere or box, not part of the articulation.
+struct ObjectSpec {
+  Shape shape = Shape::sphere(0.05);
+  double mass_kg = 1.0;
+  Material material;
+  Vec3 pos = Vec3::Zero();
+  Quat quat = Quat::Identity();
+  Vec3 lin_vel = Vec3::Zero();  // world
+  Vec3 ang_vel = Vec3::Zero();  // world
+};
+
+struct Object {
+  bool active = false;
+  std::uint32_t generation = 0;  // bumped on every add, so stale handles are caught
+  Shape shape;
+  double mass_kg = 0.0;
+  Vec3 inertia_diag = Vec3::Zero();  // principal moments, body frame (boxes and spheres are symmetric)
+  Material material;
+  Vec3 pos = Vec3::Zero();
+  Quat quat = Quat::Identity();
+  Vec3 lin_vel = Vec3::Zero();
+  Vec3 ang_vel = Vec3::Zero();  // world
+  Vec3 force = Vec3::Zero();    // external, world, applied during the next step only
+};
+
+// One side of a contact: an articulated body, an object, or the static ground.
+struct ContactSide {
+  enum class Kind : std::uint8_t { ground, body, object } kind = Kind::ground;
+  int index = -1;  // body or object slot
+  int geom = -1;   // geom of the body (articulation only)
+};
+
+struct Contact {
+  ContactSide a;  // the normal points towards a
+  ContactSide b;
+  Vec3 pos = Vec3::Zero();
+  Vec3 normal = Vec3::UnitZ();
+  Vec3 tangent1 = Vec3::UnitX();
+  Vec3 tangent2 = Vec3::UnitY();
+  double dist_m = 0.0;
+  double friction = 0.0;
+  double restitution = 0.0;
+  Vec3 impulse = Vec3::Zero();      // N*s on side a along (normal, tangent1, tangent2)
+  Vec3 force_world = Vec3::Zero();  // N on side a, averaged over the step
+
+  [[nodiscard]] double normal_force_n() const;
+};
+
+// Counters, as MuJoCo's warning statistics: the step never throws; what went
+// wrong is counted here, and `last` tells the caller about the latest step.
+struct Diagnostics {
+  std::uint32_t bad_inputs = 0;          // non-finite or absurd inputs replaced by safe values
+  std::uint32_t contact_overflow = 0;    // contact points dropped because kMaxContacts was reached
+  std::uint32_t limit_overflow = 0;      // joint-limit rows dropped
+  std::uint32_t torque_saturations = 0;  // drive torques clamped at their limit
+  std::uint32_t solver_unconverged = 0;  // steps whose contact solve hit the iteration cap
+  std::uint32_t divergences = 0;         // steps rejected as diverging (state restored)
+  int solver_iterations = 0;             // last step
+  double solver_residual = 0.0;          // last step: largest impulse change in the final sweep
+};
+
+enum class StepStatus : std::uint8_t {
+  ok,
+  sanitized,  // some inputs were replaced (counted in bad_inputs); the step ran
+  diverged,   // the state was about to become non-finite or explode: restored, caller should reset
+};
+
+struct Data {
+  // ---- state -------------------------------------------------------------
+  double time_s = 0.0;
+  RootMode root_mode = RootMode::free;
+  std::array<double, kMaxQpos> qpos{};
+  std::array<double, kMaxDofs> qvel{};
+  std::array<Object, kMaxObjects> objects{};
+
+  // ---- outputs of the last step ------------------------------------------
+  std::array<double, kMaxDofs> qacc{};    // (v+ - v) / dt
+  std::array<double, kMaxDofs> tau_pd{};  // drive torque, PD part, as applied (generalized)
+  std::array<double, kMaxDofs> tau_ff{};  // drive torque, feedforward part, as applied
+  std::array<bool, kMaxBodies> drive_saturated{};
+  Vec3 root_servo_force = Vec3::Zero();   // world, N
+  Vec3 root_servo_torque = Vec3::Zero();  // world, N*m
+  std::array<Contact, kMaxContacts> contacts{};
+  int ncon = 0;
+  Diagnostics diag;
+  StepStatus status = StepStatus::ok;
+
+  // ---- kinematics at qpos (refreshed by forward_kinematics) --------------
+  std::array<Pose, kMaxBodies> xbody{};  // body frames in the world
+  std::array<Quat, kMaxBodies> xquat{};  // the same rotations as quaternions
+  std::array<Vec3, kMaxBodies> xcom{};   // centres of mass in the world
+  std::array<Pose, kMaxGeoms> xgeom{};
+  Vec3 origin = Vec3::Zero();         // where spatial vectors are taken this step (the root)
+  std::array<Vec6, kMaxDofs> cdof{};  // motion axis of each dof (angular; linear at origin), world
+  std::array<Vec6, kMaxDofs> cdof_dot{};
+  std::array<Vec6, kMaxBodies> cvel{};      // body spatial velocities (angular; linear at origin)
+  std::array<Vec3, kMaxBodies> cinert_h{};  // spatial inertia about origin: first moment m * (com - origin)
+  std::array<Mat3, kMaxBodies> cinert_i{};  // and rotational inertia about origin, world axes
+
+  // ---- dynamics scratch ----------------------------------------------------
+  std::array<double, kMaxDofs * kMaxDofs> mass{};    // joint-space inertia, lower triangle, row stride nv
+  std::array<double, kMaxDofs * kMaxDofs> factor{};  // M + dt*Kd + dt^2*Kp, factored in place (LTDL)
+  std::array<double, kMaxDofs> bias{};               // C(q, v) + gravity
+  std::array<double, kMaxBodies> drive_kp{};         // the inputs, checked (bad values replaced)
+  std::array<double, kMaxBodies> drive_kd{};
+  std::array<double, kMaxBodies> drive_limit{};
+  std::array<double, kMaxDofs> drive_ff{};
+  std::array<double, kMaxDofs> sat_torque{};  // total drive torque of a saturated joint
+  std::array<double, kMaxDofs> kp_dof{};      // per dof this step (0 where the drive is off or saturated)
+  std::array<double, kMaxDofs> kd_dof{};
+  std::array<double, kMaxDofs> err_dof{};  // drive position error per dof (rad, m)
+  std::array<double, kMaxDofs> vref_dof{};
+  std::array<double, kMaxDofs> tau_fixed{};  // explicit torques: feedforward, explicit PD, saturated drives
+  std::array<double, kMaxDofs> qvel_free{};  // after forces and drives, before constraints
+  std::array<double, kMaxDofs> qvel_next{};  // after constraints: the end-of-step velocity
+  std::array<double, kMaxDofs> work{};
+  int first_active_dof = 0;         // dofs below are prescribed (fixed or kinematic root)
+  std::array<double, 6> root_dv{};  // prescribed root velocity change this step
+  std::array<double, kMaxQpos> qpos_saved{};
+  std::array<double, kMaxDofs> qvel_saved{};
+  std::array<Object, kMaxObjects> objects_saved{};
+
+  // ---- objects scratch ---------------------------------------------------
+  std::array<Vec3, kMaxObjects> obj_lin_free{};
+  std::array<Vec3, kMaxObjects> obj_ang_free{};
+  std::array<Vec3, kMaxObjects> obj_lin_next{};
+  std::array<Vec3, kMaxObjects> obj_ang_next{};
+  std::array<Mat3, kMaxObjects> obj_inv_inertia{};  // world
+
+  // ---- constraint rows (contacts and limits) ------------------------------
+  // One scalar constraint. A contact row measures the relative velocity of
+  // its two sides along a direction: row velocity = ua . V_a + ub . V_b, with
+  // V = (angular; linear at data.origin) for bodies and (angular; linear at
+  // the centre) for objects. A limit row acts on its joint's own dofs.
+  struct Row {
+    enum class Kind : std::uint8_t { normal, friction1, friction2, limit } kind = Kind::normal;
+    ContactSide a, b;
+    Vec6 ua = Vec6::Zero();
+    Vec6 ub = Vec6::Zero();
+    int limit_body = -1;
+    Vec3 limit_coef = Vec3::Zero();  // on the joint's dofs (the first dof_num entries)
+    double target = 0.0;             // desired row velocity (gap closing, restitution, Baumgarte)
+    double lambda = 0.0;             // impulse, N*s or N*m*s
+    int contact = -1;
+    std::uint64_t support = 0;  // dofs the row touches (bit k: dof k)
+  };
+  std::array<Row, kMaxRows> rows{};
+  int nrows = 0;
+  int nlimit_rows = 0;
+  std::array<double, kMaxRows * kMaxDofs> row_y{};     // D^-1/2 L^-T J^T per row
+  std::array<double, kMaxRows * kMaxRows> delassus{};  // J M~^-1 J^T
+  std::array<double, kMaxRows> row_v0{};               // row velocity at v_free
+  std::array<double, kMaxRows> row_pre{};              // row velocity at the start of the step
+  std::array<Contact, kMaxContacts> prev_contacts{};   // last step's, for warm starting
+  int prev_ncon = 0;
+};
+
+// Allocates and initialises a Data for `model` at its rest configuration
+// (the only allocation; everything after is in place).
+std::unique_ptr<Data> make_data(const Model& model);
+
+// Back to the rest configuration: zero velocities, no objects, counters cleared.
+void reset_data(const Model& model, Data& data);
+
+}  // namespace tonus::sim

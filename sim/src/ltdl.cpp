@@ -1,0 +1,46 @@
+#include "ltdl.hpp"
+
+#include <cstddef>
+
+namespace tonus::sim::ltdl {
+namespace {
+inline std::size_t at(int r, int c, int nv) { return static_cast<std::size_t>(r * nv + c); }
+inline int up(std::span<const int> parent, int k) { return parent[static_cast<std::size_t>(k)]; }
+}  // namespace
+
+bool factor(std::span<double> h, int nv, std::span<const int> parent, int first) {
+  for (int k = nv - 1; k >= first; --k) {
+    const double hkk = h[at(k, k, nv)];
+    if (!(hkk > 0.0)) return false;
+    for (int i = up(parent, k); i >= first; i = up(parent, i)) {
+      const double a = h[at(k, i, nv)] / hkk;
+      for (int j = i; j >= first; j = up(parent, j)) h[at(i, j, nv)] -= a * h[at(k, j, nv)];
+      h[at(k, i, nv)] = a;
+    }
+  }
+  return true;
+}
+
+void solve_lt(std::span<const double> f, int nv, std::span<const int> parent, int first, std::span<double> x) {
+  for (int k = nv - 1; k >= first; --k) {
+    const double xk = x[static_cast<std::size_t>(k)];
+    if (xk == 0.0) continue;  // rows of a contact Jacobian are zero off the contact's path
+    for (int i = up(parent, k); i >= first; i = up(parent, i)) x[static_cast<std::size_t>(i)] -= f[at(k, i, nv)] * xk;
+  }
+}
+
+void solve_l(std::span<const double> f, int nv, std::span<const int> parent, int first, std::span<double> x) {
+  for (int k = first; k < nv; ++k) {
+    double s = x[static_cast<std::size_t>(k)];
+    for (int i = up(parent, k); i >= first; i = up(parent, i)) s -= f[at(k, i, nv)] * x[static_cast<std::size_t>(i)];
+    x[static_cast<std::size_t>(k)] = s;
+  }
+}
+
+void solve(std::span<const double> f, int nv, std::span<const int> parent, int first, std::span<double> x) {
+  solve_lt(f, nv, parent, first, x);
+  for (int k = first; k < nv; ++k) x[static_cast<std::size_t>(k)] /= f[at(k, k, nv)];
+  solve_l(f, nv, parent, first, x);
+}
+
+}  // namespace tonus::sim::ltdl

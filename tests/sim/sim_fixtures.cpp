@@ -1,0 +1,76 @@
+#include "sim_fixtures.hpp"
+
+#include <doctest/doctest.h>
+
+#include <unistd.h>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+namespace tonus::sim::test {
+
+std::unique_ptr<Model> humanoid(const Features& features, Integrator integrator, const HumanoidSpec& spec) {
+  std::string error;
+  ModelBuilder mb = humanoid_builder(spec, error);
+  REQUIRE_MESSAGE(error.empty(), error);
+  mb.features(features).integrator(integrator);
+  BuildResult r = mb.build();
+  REQUIRE_MESSAGE(r, r.error);
+  return std::move(r.model);
+}
+
+Mujoco::Mujoco(const std::string& xml) {
+  char path[] = "/tmp/tonus-mjcf-XXXXXX.xml";
+  const int fd = mkstemps(path, 4);
+  if (fd < 0) {
+    error_ = "cannot create a temporary file";
+    return;
+  }
+  close(fd);
+  std::ofstream(path) << xml;
+  char err[1024] = {0};
+  model_ = mj_loadXML(path, nullptr, err, sizeof err);
+  std::remove(path);
+  if (model_ == nullptr) {
+    error_ = err;
+    return;
+  }
+  data_ = mj_makeData(model_);
+}
+
+Mujoco::~Mujoco() {
+  if (data_ != nullptr) mj_deleteData(data_);
+  if (model_ != nullptr) mj_deleteModel(model_);
+}
+
+StepInputs passive_inputs(const Model& model) {
+  StepInputs in = make_inputs(model);
+  in.kp.fill(0.0);
+  in.kd.fill(0.0);
+  return in;
+}
+
+double max_joint_difference(const Model& model, const double* q1, const double* q2) {
+  double worst = 0.0;
+  for (int i = 0; i < model.nbody; ++i) {
+    const Body& b = model.bodies[static_cast<std::size_t>(i)];
+    const int a = b.qpos_adr;
+    const auto quat_angle = [&](int at) {
+      const Quat x(q1[at], q1[at + 1], q1[at + 2], q1[at + 3]);
+      const Quat y(q2[at], q2[at + 1], q2[at + 2], q2[at + 3]);
+      return quat_log(x.normalized().conjugate() * y.normalized()).norm();
+    };
+    switch (b.joint) {
+      case JointType::free:
+        worst = std::max(worst, std::hypot(q1[a] - q2[a], q1[a + 1] - q2[a + 1], q1[a + 2] - q2[a + 2]));
+        worst = std::max(worst, quat_angle(a + 3));
+        break;
+      case JointType::ball: worst = std::max(worst, quat_angle(a)); break;
+      case JointType::hinge: worst = std::max(worst, std::abs(q1[a] - q2[a])); break;
+      case JointType::fixed: break;
+    }
+  }
+  return worst;
+}
+
+}  // namespace tonus::sim::test
