@@ -163,7 +163,6 @@ void drive_terms(const Model& model, Data& data, const StepInputs& in, DriveSche
       if (norm > limit) {
         for (size_t k = d0; k < d0 + n; ++k) data.tau_fixed[k] *= limit / norm;
         data.drive_saturated[i] = true;
-        ++data.diag.torque_saturations;
       }
     }
   }
@@ -217,7 +216,7 @@ bool drive_torques(const Model& model, Data& data, DriveScheme scheme) {
   const auto nv = static_cast<size_t>(model.nv);
   for (size_t d = 0; d < nv; ++d) {
     // Implicit: at the end-of-step state; explicit: already in tau_fixed.
-    const double v_end = data.qvel[d];
+    const double v_end = data.qvel_next[d];
     data.tau_pd[d] = -data.kp_dof[d] * (data.err_dof[d] + dt * v_end) - data.kd_dof[d] * (v_end - data.vref_dof[d]);
     data.tau_ff[d] = data.drive_ff[d];
   }
@@ -227,24 +226,44 @@ bool drive_torques(const Model& model, Data& data, DriveScheme scheme) {
     const auto n = static_cast<size_t>(b.dof_num);
     if (!implicit) {
       for (size_t k = d0; k < d0 + n; ++k) data.tau_pd[k] = data.tau_fixed[k] - data.drive_ff[k];
+      continue;  // explicit drives were clamped before the solve
     }
     if (b.joint != JointType::ball && b.joint != JointType::hinge) continue;
-    if (!implicit) continue;  // clamped before the solve
-    if (data.drive_saturated[i]) {
-      for (size_t k = d0; k < d0 + n; ++k) data.tau_pd[k] = data.sat_torque[k] - data.drive_ff[k];
-      continue;
-    }
     const double limit = data.drive_limit[i];
     if (!(limit > 0.0)) continue;
+    // The drive's law at the end-of-step state, whether or not it is saturated
+    // now: the joint is saturated exactly when this exceeds the limit.
+    std::array<double, 3> law{};
     double norm2 = 0.0;
-    for (size_t k = d0; k < d0 + n; ++k) norm2 += (data.tau_pd[k] + data.tau_ff[k]) * (data.tau_pd[k] + data.tau_ff[k]);
+    for (size_t k = 0; k < n; ++k) {
+      const size_t d = d0 + k;
+      const double v_end = data.qvel_next[d];
+      law[k] = -data.drive_kp[i] * (data.err_dof[d] + dt * v_end) - data.drive_kd[i] * (v_end - data.vref_dof[d]) +
+               data.drive_ff[d];
+      norm2 += law[k] * law[k];
+    }
     const double norm = std::sqrt(norm2);
-    if (norm <= limit * (1.0 + 1e-12)) continue;
-    // Saturated: the total drive torque, scaled back onto the limit, becomes explicit.
-    const double scale = limit / norm;
-    for (size_t k = d0; k < d0 + n; ++k) data.sat_torque[k] = (data.tau_pd[k] + data.tau_ff[k]) * scale;
+    const bool over = norm > limit * (1.0 + 1e-9);
+    if (data.drive_saturated[i]) {
+      for (size_t k = d0; k < d0 + n; ++k) data.tau_pd[k] = data.sat_torque[k] - data.drive_ff[k];
+      if (!over) {  // the limit no longer binds: back to the implicit law
+        data.drive_saturated[i] = false;
+        changed = true;
+        continue;
+      }
+      // Still saturated: follow the law's direction if it turned.
+      double turn = 0.0;
+      for (size_t k = 0; k < n; ++k) {
+        const double next = law[k] * limit / norm;
+        turn = std::max(turn, std::abs(next - data.sat_torque[d0 + k]));
+        data.sat_torque[d0 + k] = next;
+      }
+      if (turn > 1e-6 * limit) changed = true;
+      continue;
+    }
+    if (!over) continue;
+    for (size_t k = 0; k < n; ++k) data.sat_torque[d0 + k] = law[k] * limit / norm;
     data.drive_saturated[i] = true;
-    ++data.diag.torque_saturations;
     changed = true;
   }
   return changed && implicit;

@@ -62,6 +62,8 @@ void mass_matrix(const Model& model, Data& data) {
     for (int j = k; j >= 0; j = model.dof_parent[static_cast<std::size_t>(j)]) {
       data.mass[static_cast<std::size_t>(k * nv + j)] = data.cdof[static_cast<std::size_t>(j)].dot(f);
     }
+    data.mass[static_cast<std::size_t>(k * nv + k)] +=
+        model.bodies[static_cast<std::size_t>(model.dof_body[ku])].armature;
   }
 }
 

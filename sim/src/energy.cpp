@@ -15,6 +15,11 @@ Energy energy(const Model& model, const Data& data) {
     e.kinetic_j += 0.5 * data.cvel[i].dot(in.apply(data.cvel[i]));
     e.potential_j -= model.bodies[i].mass_kg * g.dot(data.xcom[i]);
   }
+  for (int k = 0; k < model.nv; ++k) {  // the armature's own kinetic energy
+    const auto ku = static_cast<std::size_t>(k);
+    e.kinetic_j +=
+        0.5 * model.bodies[static_cast<std::size_t>(model.dof_body[ku])].armature * data.qvel[ku] * data.qvel[ku];
+  }
   for (const Object& o : data.objects) {
     if (!o.active) continue;
     const Mat3 r = o.quat.toRotationMatrix();

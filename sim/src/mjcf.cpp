@@ -94,11 +94,12 @@ class Writer {
   void joint(const Body& b, const std::string& pad) {
     const std::string name = std::string(b.name_view());
     std::string spring;
+    if (b.armature > 0.0) spring += " armature=\"" + num(b.armature) + "\"";
     if (o_.drives_as_springs && (b.joint == JointType::ball || b.joint == JointType::hinge)) {
-      spring = " stiffness=\"" + num(b.drive.kp) + "\" damping=\"" + num(b.drive.kd) + "\"";
+      spring += " stiffness=\"" + num(b.drive.kp) + "\" damping=\"" + num(b.drive.kd) + "\"";
     }
     switch (b.joint) {
-      case JointType::free: out_ << pad << "<freejoint name=\"" << name << "\"/>\n"; break;
+      case JointType::free: out_ << pad << "<joint name=\"" << name << "\" type=\"free\"" << spring << "/>\n"; break;
       case JointType::ball:
         out_ << pad << "<joint name=\"" << name << "\" type=\"ball\"" << spring;
         if (b.limit.enabled) out_ << " range=\"0 " << num(b.limit.swing_max_rad) << "\"";

@@ -97,6 +97,7 @@ bool check_body(Checker& c, std::size_t i, const BodySpec& b) {
       if (l.lower_rad < -M_PI || l.upper_rad > M_PI) return c.fail(where, "limit: twist range must lie in [-pi, pi]");
     }
   }
+  if (!finite(b.armature) || b.armature < 0.0) return c.fail(where, "armature must be finite and >= 0");
   const DriveDefaults& d = b.drive;
   if (!finite(d.kp) || d.kp < 0.0) return c.fail(where, "drive.kp must be finite and >= 0");
   if (!finite(d.kd) || d.kd < 0.0) return c.fail(where, "drive.kd must be finite and >= 0");
@@ -249,6 +250,7 @@ BuildResult ModelBuilder::build() const {
     b.limit = s.limit;
     b.limit.twist_axis = s.limit.twist_axis.normalized();
     b.drive = s.drive;
+    b.armature = s.armature;
     b.dof_adr = dof;
     b.dof_num = joint_dofs(s.joint);
     b.qpos_adr = qadr;

@@ -241,6 +241,8 @@ StepStatus step(const Model& model, Data& data, const StepInputs& inputs) {
     forward_kinematics(model, data);
     return data.status;
   }
+  for (int i = 0; i < model.nbody; ++i)
+    data.diag.torque_saturations += data.drive_saturated[static_cast<size_t>(i)] ? 1U : 0U;
   data.time_s += model.timestep_s;
   forward_kinematics(model, data);
   data.status = bad > 0 ? StepStatus::sanitized : StepStatus::ok;

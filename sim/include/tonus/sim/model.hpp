@@ -77,6 +77,10 @@ struct Body {
   Mat3 inertia = Mat3::Zero();  // about the centre of mass, body-frame axes, kg*m^2
   JointLimit limit;
   DriveDefaults drive;
+  // Added to the joint-space inertia of the joint's dofs (MuJoCo's armature,
+  // kg*m^2): the reflected inertia of an actuator, and for light distal links
+  // what keeps explicit velocity-product terms stable.
+  double armature = 0.0;
 
   // Filled by the builder.
   int dof_adr = 0;  // first velocity index
@@ -126,8 +130,8 @@ struct SolverOptions {
   double contact_margin_m = 0.01;          // speculative distance, plus what the shapes sweep in one step
   double restitution_threshold_mps = 0.5;  // slower impacts do not bounce
   double limit_margin_rad = 0.05;          // speculative angle for joint limits
-  int torque_limit_passes = 3;             // re-solves when a drive saturates
-  double max_speed = 1e3;                  // any generalized velocity beyond this (m/s or rad/s) is divergence
+  int torque_limit_passes = 4;             // re-solves when a drive saturates
+  double max_speed = 1e4;                  // any generalized velocity beyond this (m/s or rad/s) is divergence
 };
 
 // Semi-implicit Euler (MuJoCo's "Euler") is the real-time integrator: drives,

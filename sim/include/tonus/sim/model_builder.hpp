@@ -22,6 +22,7 @@ struct BodySpec {
   Mat3 inertia = Mat3::Zero();
   JointLimit limit;
   DriveDefaults drive;
+  double armature = 0.0;  // kg*m^2 on each of the joint's dofs
 };
 
 struct GeomSpec {
