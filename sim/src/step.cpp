@@ -227,6 +227,11 @@ bool step_rk4(const Model& model, Data& data, const StepInputs& inputs) {
 
 StepStatus step(const Model& model, Data& data, const StepInputs& inputs) {
   [[maybe_unused]] const NoEigenMalloc guard;
+  if (!state_ok(model, data)) {  // a state broken before the step (e.g. written by the caller): refuse
+    ++data.diag.divergences;
+    data.status = StepStatus::diverged;
+    return data.status;
+  }
   save_state(model, data);
   const int bad = detail::read_inputs(model, data, inputs);
   data.diag.bad_inputs += static_cast<std::uint32_t>(bad);
