@@ -10,3 +10,7 @@ cmake --build --preset release
 # A simulated band stream pushed through the USB-HID and CAN bindings over
 # lossy links and decoded back, with every message accounted for.
 build/release/bin/tonus demo --seconds 5 --loss 0.01 --duplication 0.002 --reorder 0.002 --seed 1
+
+# The physics core: the humanoid standing on the ground, a 1 kg cube dropped
+# on its hand, a ball thrown at its chest; what happened and what it cost.
+build/release/bin/tonus physics --seconds 3

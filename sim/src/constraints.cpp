@@ -62,7 +62,7 @@ SwingTwist swing_twist(const Quat& q_in, const Vec3& t) {
 }
 
 void limit_row(const Model& model, Data& data, int body, const Vec3& coef, double dist) {
-  if (data.nlimit_rows >= static_cast<int>(kMaxLimitRows)) {
+  if (data.njoint_rows >= static_cast<int>(kMaxJointRows)) {
     ++data.diag.limit_overflow;
     return;
   }
@@ -76,7 +76,7 @@ void limit_row(const Model& model, Data& data, int body, const Vec3& coef, doubl
   // Baumgarte-corrected once outside.
   r.target = dist > 0.0 ? -dist / dt : -model.solver.baumgarte * dist / dt;
   if (add_row(data, r)) {
-    ++data.nlimit_rows;
+    ++data.njoint_rows;
   } else {
     ++data.diag.limit_overflow;
   }
@@ -133,18 +133,19 @@ double object_coupling(const Data& data, const ContactSide& s, const Vec6& u1, c
 }
 
 bool is_object(const ContactSide& s) { return s.kind == ContactSide::Kind::object; }
+bool is_joint_row(const Row& r) { return r.kind == Row::Kind::limit || r.kind == Row::Kind::drive; }
 
 }  // namespace
 
 void build_rows(const Model& model, Data& data) {
   data.nrows = 0;
-  data.nlimit_rows = 0;
+  data.njoint_rows = 0;
   for (int ci = 0; ci < data.ncon; ++ci) {
     const Contact& c = data.contacts[static_cast<size_t>(ci)];
     const std::uint64_t support = side_support(model, c.a) | side_support(model, c.b);
     const Vec3 dirs[3] = {c.normal, c.tangent1, c.tangent2};
     const int nrow = c.friction > 0.0 ? 3 : 1;
-    if (data.nrows + nrow > static_cast<int>(kMaxRows - kMaxLimitRows)) {
+    if (data.nrows + nrow > static_cast<int>(kMaxRows - kMaxJointRows)) {
       ++data.diag.contact_overflow;
       continue;
     }
@@ -162,6 +163,7 @@ void build_rows(const Model& model, Data& data) {
     }
   }
   if (model.features.limits) build_limit_rows(model, data);
+  data.nbase_rows = data.nrows;
 }
 
 void assemble_rows(const Model& model, Data& data) {
@@ -183,7 +185,7 @@ void assemble_rows(const Model& model, Data& data) {
     double* y = &data.row_y[r * kMaxDofs];
     std::fill_n(y, unv, 0.0);
     // J on the articulation.
-    if (row.kind == Row::Kind::limit) {
+    if (is_joint_row(row)) {
       const Body& b = model.bodies[static_cast<size_t>(row.limit_body)];
       for (int k = 0; k < b.dof_num; ++k) y[b.dof_adr + k] = row.limit_coef(k);
     } else {
@@ -222,7 +224,7 @@ void assemble_rows(const Model& model, Data& data) {
         const auto k = static_cast<size_t>(std::countr_zero(bits));
         a += yr[k] * ys[k];
       }
-      if (rr.kind != Row::Kind::limit && rs.kind != Row::Kind::limit) {
+      if (!is_joint_row(rr) && !is_joint_row(rs)) {
         if (is_object(rr.a) && is_object(rs.a) && rr.a.index == rs.a.index)
           a += object_coupling(data, rr.a, rr.ua, rs.ua);
         if (is_object(rr.a) && is_object(rs.b) && rr.a.index == rs.b.index)
@@ -277,8 +279,32 @@ void solve_rows(const Model& model, Data& data) {
       }
       if (row.kind == Row::Kind::normal || row.kind == Row::Kind::limit) {
         const double next = std::max(0.0, row.lambda + (row.target - row_velocity(r)) / arr);
-        residual = std::max(residual, std::abs(next - row.lambda));
+        residual = std::max(residual, std::abs(next - row.lambda) * arr);
         row.lambda = next;
+      } else if (row.kind == Row::Kind::drive) {
+        // A drive's rows (one per dof of the joint), each a compliant target,
+        // then the group's torque bounded as a vector.
+        const auto first = static_cast<size_t>(row.group);
+        size_t last = first;
+        while (last + 1 < n && data.rows[last + 1].kind == Row::Kind::drive && data.rows[last + 1].group == row.group)
+          ++last;
+        double norm2 = 0.0;
+        std::array<double, 3> next{};
+        for (size_t k = first; k <= last; ++k) {
+          Row& rk = data.rows[k];
+          const double akk = data.delassus[k * n + k] + rk.cfm;
+          next[k - first] = rk.lambda + (rk.target - row_velocity(k) - rk.cfm * rk.lambda) / akk;
+          norm2 += next[k - first] * next[k - first];
+        }
+        const double norm = std::sqrt(norm2);
+        const double scale = norm > row.bound ? row.bound / norm : 1.0;
+        for (size_t k = first; k <= last; ++k) {
+          Row& rk = data.rows[k];
+          const double l = next[k - first] * scale;
+          residual = std::max(residual, std::abs(l - rk.lambda) * (data.delassus[k * n + k] + rk.cfm));
+          rk.lambda = l;
+        }
+        r = last;
       } else if (row.kind == Row::Kind::friction1) {
         // Both tangent rows, then projection onto the Coulomb disc.
         Row& row2 = data.rows[r + 1];
@@ -290,7 +316,8 @@ void solve_rows(const Model& model, Data& data) {
         const double cap = c.friction * data.rows[r - 1].lambda;
         const double norm = std::hypot(l1, l2);
         const double scale = norm > cap ? (norm > 0.0 ? cap / norm : 0.0) : 1.0;
-        residual = std::max({residual, std::abs(l1 * scale - row.lambda), std::abs(l2 * scale - row2.lambda)});
+        residual =
+            std::max({residual, std::abs(l1 * scale - row.lambda) * arr, std::abs(l2 * scale - row2.lambda) * a22});
         row.lambda = l1 * scale;
         row2.lambda = l2 * scale;
         ++r;  // friction2 done with it
@@ -331,7 +358,7 @@ void apply_impulses(const Model& model, Data& data) {
   }
   for (size_t r = 0; r < n; ++r) {
     const Row& row = data.rows[r];
-    if (row.kind == Row::Kind::limit || row.lambda == 0.0) continue;
+    if (is_joint_row(row) || row.lambda == 0.0) continue;
     for (const auto* side : {&row.a, &row.b}) {
       if (!is_object(*side)) continue;
       const Vec6& u = side == &row.a ? row.ua : row.ub;
@@ -347,7 +374,7 @@ void report_contacts(const Model& model, Data& data) {
   for (int i = 0; i < data.ncon; ++i) data.contacts[static_cast<size_t>(i)].impulse.setZero();
   for (int r = 0; r < data.nrows; ++r) {
     const Row& row = data.rows[static_cast<size_t>(r)];
-    if (row.kind == Row::Kind::limit) continue;
+    if (is_joint_row(row)) continue;
     Contact& c = data.contacts[static_cast<size_t>(row.contact)];
     const int k = row.kind == Row::Kind::normal ? 0 : (row.kind == Row::Kind::friction1 ? 1 : 2);
     c.impulse(k) = row.lambda;

@@ -23,6 +23,8 @@ void reset_data(const Model& model, Data& data) {
   data.tau_pd.fill(0.0);
   data.tau_ff.fill(0.0);
   data.drive_saturated.fill(false);
+  data.drive_in_rows.fill(false);
+  data.drive_impulse.fill(0.0);
   for (Object& o : data.objects) o.active = false;  // generations survive, so old handles stay stale
   data.ncon = 0;
   data.prev_ncon = 0;

@@ -1,8 +1,15 @@
-// The PD drives and the root servo. Implicit drives fold Kp and Kd into the
-// joint-space inertia, so the torque is the one the end-of-step state calls
-// for: (M + dt Kd + dt^2 Kp) dv = dt (tau - c - Kp (e + dt v) - Kd (v - vref)).
-// A drive over its torque limit becomes an explicit, clamped torque and the
-// pass is redone (an active set, at most solver.torque_limit_passes times).
+// The PD drives and the root servo. Each drive's law is evaluated at the
+// end-of-step state (implicit, "stable PD"):
+//   tau = -Kp (e + dt v+) - Kd (v+ - vref) + tau_ff.
+// Drives within their torque limit fold Kp and Kd into the joint-space
+// inertia and are solved exactly by the factorisation:
+//   (M + dt Kd + dt^2 Kp) dv = dt (tau_ff - c - Kp (e + dt v) - Kd (v - vref)).
+// A drive whose law exceeds its limit leaves the inertia and becomes a
+// compliant row of the constraint solve (ODE/Springhead's soft constraint:
+// compliance 1 / (dt (Kd + dt Kp))) whose impulse is bounded by the limit, so
+// it yields exactly as much as the limit makes it, coupled with the contacts.
+// An explicit clamped torque would not do: on a light axis (an arm's twist)
+// it overshoots within one step and chatters.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -76,21 +83,19 @@ int read_inputs(const Model& model, Data& data, const StepInputs& in) {
   return bad;
 }
 
-void drive_terms(const Model& model, Data& data, const StepInputs& in, DriveScheme scheme) {
-  const bool implicit = scheme == DriveScheme::implicit;
+void drive_errors(const Model& model, Data& data, const StepInputs& in) {
   const auto nv = static_cast<size_t>(model.nv);
-  std::fill_n(data.kp_dof.begin(), nv, 0.0);
-  std::fill_n(data.kd_dof.begin(), nv, 0.0);
+  std::fill_n(data.law_kp.begin(), nv, 0.0);
+  std::fill_n(data.law_kd.begin(), nv, 0.0);
   std::fill_n(data.err_dof.begin(), nv, 0.0);
   std::fill_n(data.vref_dof.begin(), nv, 0.0);
-  for (size_t d = 0; d < nv; ++d) data.tau_fixed[d] = data.drive_ff[d];
-
   for (size_t i = 0; i < static_cast<size_t>(model.nbody); ++i) {
     const Body& b = model.bodies[i];
     const auto d0 = static_cast<size_t>(b.dof_adr);
     const auto q0 = static_cast<size_t>(b.qpos_adr);
     Vec3 err = Vec3::Zero();
-    double kp = data.drive_kp[i], kd = data.drive_kd[i];
+    double kp = data.drive_kp[i];
+    const double kd = data.drive_kd[i];
     switch (b.joint) {
       case JointType::hinge: {
         const double target = in.target_qpos[q0];
@@ -112,7 +117,8 @@ void drive_terms(const Model& model, Data& data, const StepInputs& in, DriveSche
         // The root servo, in free mode only.
         const RootServo& s = in.root_servo;
         const bool usable = s.enabled && data.root_mode == RootMode::free && all_finite(in.root_pos) &&
-                            all_finite(in.root_lin_vel) && all_finite(in.root_ang_vel) && in.root_quat.norm() > 0.5;
+                            all_finite(in.root_lin_vel) && all_finite(in.root_ang_vel) && finite(in.root_quat.norm()) &&
+                            in.root_quat.norm() > 0.5;
         if (!usable) continue;
         const Vec3 pos(data.qpos[q0], data.qpos[q0 + 1], data.qpos[q0 + 2]);
         const Vec3 e_lin = pos - in.root_pos;
@@ -120,39 +126,50 @@ void drive_terms(const Model& model, Data& data, const StepInputs& in, DriveSche
             quat_log(in.root_quat.normalized().conjugate() * read_quat(data.qpos, b.qpos_adr + 3).normalized());
         for (size_t k = 0; k < 3; ++k) {
           const auto ke = static_cast<Eigen::Index>(k);
-          data.kp_dof[d0 + k] = finite(s.kp_lin) ? std::max(s.kp_lin, 0.0) : 0.0;
-          data.kd_dof[d0 + k] = finite(s.kd_lin) ? std::max(s.kd_lin, 0.0) : 0.0;
-          data.kp_dof[d0 + 3 + k] = finite(s.kp_ang) ? std::max(s.kp_ang, 0.0) : 0.0;
-          data.kd_dof[d0 + 3 + k] = finite(s.kd_ang) ? std::max(s.kd_ang, 0.0) : 0.0;
+          data.law_kp[d0 + k] = finite(s.kp_lin) ? std::max(s.kp_lin, 0.0) : 0.0;
+          data.law_kd[d0 + k] = finite(s.kd_lin) ? std::max(s.kd_lin, 0.0) : 0.0;
+          data.law_kp[d0 + 3 + k] = finite(s.kp_ang) ? std::max(s.kp_ang, 0.0) : 0.0;
+          data.law_kd[d0 + 3 + k] = finite(s.kd_ang) ? std::max(s.kd_ang, 0.0) : 0.0;
           data.err_dof[d0 + k] = e_lin(ke);
           data.err_dof[d0 + 3 + k] = e_ang(ke);
           data.vref_dof[d0 + k] = in.root_lin_vel(ke);
           data.vref_dof[d0 + 3 + k] = in.root_ang_vel(ke);
         }
-        if (!implicit) {
-          for (size_t k = d0; k < d0 + 6; ++k) {
-            data.tau_fixed[k] += -data.kp_dof[k] * data.err_dof[k] - data.kd_dof[k] * (data.qvel[k] - data.vref_dof[k]);
-            data.kp_dof[k] = data.kd_dof[k] = 0.0;
-          }
-        }
         continue;
       }
       case JointType::fixed: continue;
     }
-    const auto n = static_cast<size_t>(b.dof_num);
-    for (size_t k = 0; k < n; ++k) {
+    for (size_t k = 0; k < static_cast<size_t>(b.dof_num); ++k) {
       const size_t d = d0 + k;
       const double vref = in.target_qvel[d];
+      data.law_kp[d] = kp;
+      data.law_kd[d] = kd;
       data.err_dof[d] = err(static_cast<Eigen::Index>(k));
       data.vref_dof[d] = finite(vref) ? vref : 0.0;
-      if (data.drive_saturated[i]) {
-        data.tau_fixed[d] = data.sat_torque[d];
-      } else if (implicit) {
-        data.kp_dof[d] = kp;
-        data.kd_dof[d] = kd;
-      } else {
-        data.tau_fixed[d] += -kp * data.err_dof[d] - kd * (data.qvel[d] - data.vref_dof[d]);
-      }
+    }
+  }
+}
+
+void drive_terms(const Model& model, Data& data, DriveScheme scheme) {
+  const bool implicit = scheme == DriveScheme::implicit;
+  const auto nv = static_cast<size_t>(model.nv);
+  for (size_t d = 0; d < nv; ++d) {
+    data.kp_dof[d] = implicit ? data.law_kp[d] : 0.0;
+    data.kd_dof[d] = implicit ? data.law_kd[d] : 0.0;
+    data.tau_fixed[d] = data.drive_ff[d];
+    if (!implicit) {
+      data.tau_fixed[d] += -data.law_kp[d] * data.err_dof[d] - data.law_kd[d] * (data.qvel[d] - data.vref_dof[d]);
+    }
+  }
+  for (size_t i = 0; i < static_cast<size_t>(model.nbody); ++i) {
+    const Body& b = model.bodies[i];
+    if (b.joint != JointType::ball && b.joint != JointType::hinge) continue;
+    const auto d0 = static_cast<size_t>(b.dof_adr);
+    const auto n = static_cast<size_t>(b.dof_num);
+    if (implicit && data.drive_in_rows[i]) {
+      // Solved as a bounded row: neither in the inertia nor as a fixed torque.
+      for (size_t d = d0; d < d0 + n; ++d) data.kp_dof[d] = data.kd_dof[d] = data.tau_fixed[d] = 0.0;
+      continue;
     }
     // Explicit drives are clamped here, once: their torque is known before the solve.
     const double limit = data.drive_limit[i];
@@ -164,6 +181,47 @@ void drive_terms(const Model& model, Data& data, const StepInputs& in, DriveSche
         for (size_t k = d0; k < d0 + n; ++k) data.tau_fixed[k] *= limit / norm;
         data.drive_saturated[i] = true;
       }
+    }
+  }
+}
+
+void add_drive_rows(const Model& model, Data& data) {
+  const double dt = model.timestep_s;
+  data.nrows = data.nbase_rows;
+  for (size_t i = 0; i < static_cast<size_t>(model.nbody); ++i) {
+    if (!data.drive_in_rows[i]) continue;
+    const Body& b = model.bodies[i];
+    const auto d0 = static_cast<size_t>(b.dof_adr);
+    const double stiffness = data.law_kd[d0] + dt * data.law_kp[d0];  // K' of the law, per dof
+    const bool fits = data.nrows + b.dof_num <= static_cast<int>(kMaxRows) &&
+                      data.njoint_rows + b.dof_num <= static_cast<int>(kMaxJointRows);
+    if (!(stiffness > 0.0) || !fits) {
+      // A constant feedforward alone, or no room: back to the inertia (unclamped, counted if for room).
+      if (!fits) ++data.diag.limit_overflow;
+      data.drive_in_rows[i] = false;
+      for (size_t d = d0; d < d0 + static_cast<size_t>(b.dof_num); ++d) {
+        data.kp_dof[d] = data.law_kp[d];
+        data.kd_dof[d] = data.law_kd[d];
+        data.tau_fixed[d] = data.drive_ff[d];
+      }
+      continue;
+    }
+    const int group = data.nrows;
+    for (int k = 0; k < b.dof_num; ++k) {
+      const size_t d = d0 + static_cast<size_t>(k);
+      Data::Row r;
+      r.kind = Data::Row::Kind::drive;
+      r.limit_body = static_cast<int>(i);
+      r.limit_coef = Vec3::Unit(k);
+      r.support = model.body_path_dofs[i];
+      // tau = -K' (v+ - v*): the law rearranged around its velocity target.
+      r.target = (data.law_kd[d] * data.vref_dof[d] - data.law_kp[d] * data.err_dof[d] + data.drive_ff[d]) / stiffness;
+      r.cfm = 1.0 / (dt * stiffness);
+      r.bound = data.drive_limit[i] * dt;
+      r.group = group;
+      r.lambda = data.drive_impulse[d];
+      data.rows[static_cast<size_t>(data.nrows++)] = r;
+      ++data.njoint_rows;
     }
   }
 }
@@ -212,61 +270,68 @@ bool free_velocity(const Model& model, Data& data) {
 bool drive_torques(const Model& model, Data& data, DriveScheme scheme) {
   const double dt = model.timestep_s;
   const bool implicit = scheme == DriveScheme::implicit;
-  bool changed = false;
   const auto nv = static_cast<size_t>(model.nv);
   for (size_t d = 0; d < nv; ++d) {
-    // Implicit: at the end-of-step state; explicit: already in tau_fixed.
-    const double v_end = data.qvel_next[d];
-    data.tau_pd[d] = -data.kp_dof[d] * (data.err_dof[d] + dt * v_end) - data.kd_dof[d] * (v_end - data.vref_dof[d]);
     data.tau_ff[d] = data.drive_ff[d];
+    if (implicit) {
+      const double v_end = data.qvel_next[d];
+      data.tau_pd[d] = -data.kp_dof[d] * (data.err_dof[d] + dt * v_end) - data.kd_dof[d] * (v_end - data.vref_dof[d]);
+    } else {
+      data.tau_pd[d] = data.tau_fixed[d] - data.drive_ff[d];  // clamped before the solve
+    }
   }
+  if (!implicit) return false;
+  // Drive rows: their impulse is the torque applied.
+  for (int r = data.nbase_rows; r < data.nrows; ++r) {
+    const Data::Row& row = data.rows[static_cast<size_t>(r)];
+    if (row.kind != Data::Row::Kind::drive) continue;
+    const Body& b = model.bodies[static_cast<size_t>(row.limit_body)];
+    const size_t d = static_cast<size_t>(b.dof_adr) + static_cast<size_t>(r - row.group);
+    data.tau_pd[d] = row.lambda / dt - data.drive_ff[d];
+    data.drive_impulse[d] = row.lambda;
+  }
+  bool changed = false;
   for (size_t i = 0; i < static_cast<size_t>(model.nbody); ++i) {
     const Body& b = model.bodies[i];
-    const auto d0 = static_cast<size_t>(b.dof_adr);
-    const auto n = static_cast<size_t>(b.dof_num);
-    if (!implicit) {
-      for (size_t k = d0; k < d0 + n; ++k) data.tau_pd[k] = data.tau_fixed[k] - data.drive_ff[k];
-      continue;  // explicit drives were clamped before the solve
-    }
     if (b.joint != JointType::ball && b.joint != JointType::hinge) continue;
     const double limit = data.drive_limit[i];
     if (!(limit > 0.0)) continue;
-    // The drive's law at the end-of-step state, whether or not it is saturated
-    // now: the joint is saturated exactly when this exceeds the limit.
-    std::array<double, 3> law{};
+    const auto d0 = static_cast<size_t>(b.dof_adr);
+    const auto n = static_cast<size_t>(b.dof_num);
     double norm2 = 0.0;
-    for (size_t k = 0; k < n; ++k) {
-      const size_t d = d0 + k;
-      const double v_end = data.qvel_next[d];
-      law[k] = -data.drive_kp[i] * (data.err_dof[d] + dt * v_end) - data.drive_kd[i] * (v_end - data.vref_dof[d]) +
-               data.drive_ff[d];
-      norm2 += law[k] * law[k];
+    for (size_t d = d0; d < d0 + n; ++d) {
+      const double total = data.tau_pd[d] + data.tau_ff[d];
+      norm2 += total * total;
     }
     const double norm = std::sqrt(norm2);
-    const bool over = norm > limit * (1.0 + 1e-9);
-    if (data.drive_saturated[i]) {
-      for (size_t k = d0; k < d0 + n; ++k) data.tau_pd[k] = data.sat_torque[k] - data.drive_ff[k];
-      if (!over) {  // the limit no longer binds: back to the implicit law
-        data.drive_saturated[i] = false;
-        changed = true;
-        continue;
-      }
-      // Still saturated: follow the law's direction if it turned.
-      double turn = 0.0;
-      for (size_t k = 0; k < n; ++k) {
-        const double next = law[k] * limit / norm;
-        turn = std::max(turn, std::abs(next - data.sat_torque[d0 + k]));
-        data.sat_torque[d0 + k] = next;
-      }
-      if (turn > 1e-6 * limit) changed = true;
-      continue;
+    if (data.drive_in_rows[i]) {
+      data.drive_saturated[i] = norm >= limit * (1.0 - 1e-6);
+    } else if (norm > limit * (1.0 + 1e-9)) {
+      // Over the limit in the inertia: move it to the rows and redo the pass.
+      data.drive_in_rows[i] = true;
+      for (size_t d = d0; d < d0 + n; ++d)
+        data.drive_impulse[d] = (data.tau_pd[d] + data.tau_ff[d]) * (limit / norm) * dt;
+      changed = true;
     }
-    if (!over) continue;
-    for (size_t k = 0; k < n; ++k) data.sat_torque[d0 + k] = law[k] * limit / norm;
-    data.drive_saturated[i] = true;
-    changed = true;
   }
-  return changed && implicit;
+  return changed;
+}
+
+void release_drive_rows(const Model& model, Data& data) {
+  // Drives comfortably inside their limit go back to the exact factorisation
+  // next step; the margin keeps a drive near its limit from flipping each step.
+  constexpr double kRelease = 0.8;
+  for (size_t i = 0; i < static_cast<size_t>(model.nbody); ++i) {
+    if (!data.drive_in_rows[i]) continue;
+    const Body& b = model.bodies[i];
+    double norm2 = 0.0;
+    for (size_t d = static_cast<size_t>(b.dof_adr); d < static_cast<size_t>(b.dof_adr + b.dof_num); ++d) {
+      const double total = data.tau_pd[d] + data.tau_ff[d];
+      norm2 += total * total;
+    }
+    if (std::sqrt(norm2) < kRelease * data.drive_limit[i] || !(data.drive_limit[i] > 0.0))
+      data.drive_in_rows[i] = false;
+  }
 }
 
 }  // namespace tonus::sim::detail

@@ -13,18 +13,28 @@ namespace tonus::sim::detail {
 // many values were replaced.
 int read_inputs(const Model& model, Data& data, const StepInputs& inputs);
 
-// Per-dof stiffness, damping, position error, reference velocity and the
-// explicit torques of this pass (saturated drives become explicit).
-void drive_terms(const Model& model, Data& data, const StepInputs& inputs, DriveScheme scheme);
+// Each drive's law per dof: gains, position error, reference velocity (once per step).
+void drive_errors(const Model& model, Data& data, const StepInputs& inputs);
+
+// This pass's split of the laws: into the inertia (kp_dof, kd_dof), into
+// explicit torques (tau_fixed: feedforward, explicit scheme), or into rows.
+void drive_terms(const Model& model, Data& data, DriveScheme scheme);
+
+// Bounded compliant rows for the drives that reached their torque limit
+// (after the contact and limit rows).
+void add_drive_rows(const Model& model, Data& data);
 
 // M + dt*Kd + dt^2*Kp on the simulated dofs, factored; then the velocity
 // the articulation would reach without constraints (data.qvel_free).
 // False when the matrix is not positive definite.
 bool free_velocity(const Model& model, Data& data);
 
-// Drive torques at the end-of-step velocity; marks newly saturated joints.
-// Returns true when a saturation changed (the pass must be redone).
+// Drive torques as applied; moves drives over their limit into rows.
+// Returns true when one moved (the pass must be redone).
 bool drive_torques(const Model& model, Data& data, DriveScheme scheme);
+
+// After the step: drives well inside their limit leave the rows.
+void release_drive_rows(const Model& model, Data& data);
 
 // Objects: gravity, external force, gyroscopic term; world inverse inertia.
 void objects_free_velocity(const Model& model, Data& data);

@@ -139,10 +139,15 @@ bool step_euler(const Model& model, Data& data, const StepInputs& inputs) {
   detail::objects_free_velocity(model, data);
   detail::detect_contacts(model, data);
   detail::build_rows(model, data);
+  detail::drive_errors(model, data, inputs);
+  if (inputs.scheme != DriveScheme::implicit) data.drive_in_rows.fill(false);
 
+  // Usually one pass; another when a drive crosses its torque limit and moves
+  // from the factorisation into the rows.
   bool ok = true;
   for (int pass = 0;; ++pass) {
-    detail::drive_terms(model, data, inputs, inputs.scheme);
+    detail::drive_terms(model, data, inputs.scheme);
+    detail::add_drive_rows(model, data);
     if (!detail::free_velocity(model, data)) {
       ok = false;
       break;
@@ -150,11 +155,12 @@ bool step_euler(const Model& model, Data& data, const StepInputs& inputs) {
     detail::assemble_rows(model, data);
     detail::solve_rows(model, data);
     detail::apply_impulses(model, data);
-    const bool resaturated = detail::drive_torques(model, data, inputs.scheme);
-    if (!resaturated || pass >= model.solver.torque_limit_passes) break;
+    const bool moved = detail::drive_torques(model, data, inputs.scheme);
+    if (!moved || pass >= model.solver.torque_limit_passes) break;
   }
 
   if (!ok) return false;
+  detail::release_drive_rows(model, data);
   report_root_servo(model, data);
   detail::integrate(model, data, inputs);
   detail::report_contacts(model, data);
@@ -177,7 +183,8 @@ bool step_rk4(const Model& model, Data& data, const StepInputs& inputs) {
     mass_matrix(model, data);
     const std::array<double, kMaxDofs> zero{};
     inverse_dynamics(model, data, zero, data.bias);
-    detail::drive_terms(model, data, inputs, DriveScheme::explicit_baseline);
+    detail::drive_errors(model, data, inputs);
+    detail::drive_terms(model, data, DriveScheme::explicit_baseline);
     if (!detail::free_velocity(model, data)) return false;
     for (size_t k = 0; k < nv; ++k) {
       vel[i][k] = data.qvel[k];

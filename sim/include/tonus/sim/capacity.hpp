@@ -8,14 +8,14 @@
 
 namespace tonus::sim {
 
-inline constexpr std::size_t kMaxBodies = 32;                              // articulated bodies, root included
-inline constexpr std::size_t kMaxDofs = 64;                                // generalized velocities of the articulation
-inline constexpr std::size_t kMaxQpos = 88;                                // generalized positions (quaternions take 4)
-inline constexpr std::size_t kMaxGeoms = 48;                               // collision shapes on the articulation
-inline constexpr std::size_t kMaxObjects = 16;                             // free virtual objects (balls, cubes)
-inline constexpr std::size_t kMaxContacts = 64;                            // contact points per step
-inline constexpr std::size_t kMaxLimitRows = 64;                           // active joint-limit rows per step
-inline constexpr std::size_t kMaxRows = 3 * kMaxContacts + kMaxLimitRows;  // constraint rows
+inline constexpr std::size_t kMaxBodies = 32;     // articulated bodies, root included
+inline constexpr std::size_t kMaxDofs = 64;       // generalized velocities of the articulation
+inline constexpr std::size_t kMaxQpos = 88;       // generalized positions (quaternions take 4)
+inline constexpr std::size_t kMaxGeoms = 48;      // collision shapes on the articulation
+inline constexpr std::size_t kMaxObjects = 16;    // free virtual objects (balls, cubes)
+inline constexpr std::size_t kMaxContacts = 64;   // contact points per step
+inline constexpr std::size_t kMaxJointRows = 96;  // joint rows per step: active limits and torque-limited drives
+inline constexpr std::size_t kMaxRows = 3 * kMaxContacts + kMaxJointRows;  // constraint rows
 inline constexpr std::size_t kNameLength = 32;                             // body names, NUL included
 
 static_assert(kMaxDofs >= 6 + 3 * (kMaxBodies - 1) / 2, "room for a humanoid of ball joints");

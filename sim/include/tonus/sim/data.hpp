@@ -78,7 +78,7 @@ struct Diagnostics {
   std::uint32_t solver_unconverged = 0;  // steps whose contact solve hit the iteration cap
   std::uint32_t divergences = 0;         // steps rejected as diverging (state restored)
   int solver_iterations = 0;             // last step
-  double solver_residual = 0.0;          // last step: largest impulse change in the final sweep
+  double solver_residual = 0.0;          // last step: largest row-velocity change in the final sweep (m/s, rad/s)
 };
 
 enum class StepStatus : std::uint8_t {
@@ -96,12 +96,12 @@ struct Data {
   std::array<Object, kMaxObjects> objects{};
 
   // ---- outputs of the last step ------------------------------------------
-  std::array<double, kMaxDofs> qacc{};    // (v+ - v) / dt
-  std::array<double, kMaxDofs> tau_pd{};  // drive torque, PD part, as applied (generalized)
-  std::array<double, kMaxDofs> tau_ff{};  // drive torque, feedforward part, as applied
-  std::array<bool, kMaxBodies> drive_saturated{};
-  Vec3 root_servo_force = Vec3::Zero();   // world, N
-  Vec3 root_servo_torque = Vec3::Zero();  // world, N*m
+  std::array<double, kMaxDofs> qacc{};             // (v+ - v) / dt
+  std::array<double, kMaxDofs> tau_pd{};           // drive torque, PD part, as applied (generalized)
+  std::array<double, kMaxDofs> tau_ff{};           // drive torque, feedforward part, as applied
+  std::array<bool, kMaxBodies> drive_saturated{};  // the drive's torque sat on its limit
+  Vec3 root_servo_force = Vec3::Zero();            // world, N
+  Vec3 root_servo_torque = Vec3::Zero();           // world, N*m
   std::array<Contact, kMaxContacts> contacts{};
   int ncon = 0;
   Diagnostics diag;
@@ -127,8 +127,13 @@ struct Data {
   std::array<double, kMaxBodies> drive_kd{};
   std::array<double, kMaxBodies> drive_limit{};
   std::array<double, kMaxDofs> drive_ff{};
-  std::array<double, kMaxDofs> sat_torque{};  // total drive torque of a saturated joint
-  std::array<double, kMaxDofs> kp_dof{};      // per dof this step (0 where the drive is off or saturated)
+  // Drives that reached their torque limit are solved as bounded rows (see
+  // drives.cpp); they stay there while they press against the limit.
+  std::array<bool, kMaxBodies> drive_in_rows{};
+  std::array<double, kMaxDofs> drive_impulse{};  // their last impulse (warm start), N*m*s
+  std::array<double, kMaxDofs> law_kp{};         // each drive's law per dof this step
+  std::array<double, kMaxDofs> law_kd{};
+  std::array<double, kMaxDofs> kp_dof{};  // the part folded into the inertia this pass
   std::array<double, kMaxDofs> kd_dof{};
   std::array<double, kMaxDofs> err_dof{};  // drive position error per dof (rad, m)
   std::array<double, kMaxDofs> vref_dof{};
@@ -153,9 +158,9 @@ struct Data {
   // One scalar constraint. A contact row measures the relative velocity of
   // its two sides along a direction: row velocity = ua . V_a + ub . V_b, with
   // V = (angular; linear at data.origin) for bodies and (angular; linear at
-  // the centre) for objects. A limit row acts on its joint's own dofs.
+  // the centre) for objects. Limit and drive rows act on their joint's own dofs.
   struct Row {
-    enum class Kind : std::uint8_t { normal, friction1, friction2, limit } kind = Kind::normal;
+    enum class Kind : std::uint8_t { normal, friction1, friction2, limit, drive } kind = Kind::normal;
     ContactSide a, b;
     Vec6 ua = Vec6::Zero();
     Vec6 ub = Vec6::Zero();
@@ -163,12 +168,16 @@ struct Data {
     Vec3 limit_coef = Vec3::Zero();  // on the joint's dofs (the first dof_num entries)
     double target = 0.0;             // desired row velocity (gap closing, restitution, Baumgarte)
     double lambda = 0.0;             // impulse, N*s or N*m*s
+    double cfm = 0.0;                // compliance of a drive row: 1 / (dt (Kd + dt Kp))
+    double bound = 0.0;              // a drive row group's impulse limit (norm over the group)
+    int group = -1;                  // a drive row's first row (a ball joint's three rows are projected together)
     int contact = -1;
     std::uint64_t support = 0;  // dofs the row touches (bit k: dof k)
   };
   std::array<Row, kMaxRows> rows{};
   int nrows = 0;
-  int nlimit_rows = 0;
+  int njoint_rows = 0;
+  int nbase_rows = 0;                                  // contact and limit rows; drive rows follow
   std::array<double, kMaxRows * kMaxDofs> row_y{};     // D^-1/2 L^-T J^T per row
   std::array<double, kMaxRows * kMaxRows> delassus{};  // J M~^-1 J^T
   std::array<double, kMaxRows> row_v0{};               // row velocity at v_free

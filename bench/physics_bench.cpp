@@ -1,0 +1,201 @@
+// The physics step against MuJoCo on the same scene, in one run: the default
+// humanoid standing on the ground with stiff drives (a 40 Hz hold, so it
+// stands like a statue on its own), feet and toes on the ground, a 1 kg cube
+// resting on its left hand, dt = 1 ms. MuJoCo runs the MJCF export of exactly
+// that (drives as joint springs toward the standing pose, the same cube).
+#include <benchmark/benchmark.h>
+#include <mujoco/mujoco.h>
+
+#include <unistd.h>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "tonus/sim/humanoid.hpp"
+#include "tonus/sim/mjcf.hpp"
+#include "tonus/sim/objects.hpp"
+#include "tonus/sim/step.hpp"
+
+namespace {
+
+using namespace tonus::sim;
+
+constexpr int kSettleSteps = 500;
+
+struct Scene {
+  std::unique_ptr<Model> model;
+  std::unique_ptr<Data> data;
+  StepInputs inputs;
+};
+
+std::unique_ptr<Model> standing_humanoid() {
+  HumanoidSpec spec;
+  spec.drive_frequency_hz = 40.0;
+  BuildResult r = build_humanoid(spec);
+  if (!r) {
+    std::fprintf(stderr, "tonus-bench-physics: %s\n", r.error.c_str());
+    std::exit(1);
+  }
+  return std::move(r.model);
+}
+
+void add_cube_on_hand(const Model& m, Data& d) {
+  const std::size_t hand = index(Bone::LeftHand);
+  const Pose& x = d.xgeom[hand];
+  ObjectSpec cube;
+  cube.shape = Shape::box(Vec3::Constant(0.04));
+  cube.mass_kg = 1.0;
+  cube.pos = x.pos + Vec3(0, 0, m.geoms[hand].shape.half_extents_m.z() + 0.04 + 0.002);
+  if (add_object(d, cube).error != ObjectError::none) std::exit(1);
+}
+
+Scene standing_scene() {
+  Scene s;
+  s.model = standing_humanoid();
+  s.data = make_data(*s.model);
+  s.inputs = make_inputs(*s.model);
+  add_cube_on_hand(*s.model, *s.data);
+  for (int i = 0; i < kSettleSteps; ++i) step(*s.model, *s.data, s.inputs);
+  return s;
+}
+
+void BM_HumanoidStep(benchmark::State& state) {
+  Scene s = standing_scene();
+  for (auto _ : state) {
+    step(*s.model, *s.data, s.inputs);
+    benchmark::DoNotOptimize(s.data->qpos.data());
+  }
+  state.counters["contacts"] = s.data->ncon;
+  state.counters["solver_iterations"] = s.data->diag.solver_iterations;
+  if (s.data->status == StepStatus::diverged) state.SkipWithError("the scene diverged");
+}
+BENCHMARK(BM_HumanoidStep);
+
+// The dual PD tick: simulation A (kinematic root, stiff drives, no objects)
+// tracks the reference and its applied PD torque is simulation B's
+// feedforward; B (free root, weak drives, the cube) feeds the avatar.
+void BM_DualTick(benchmark::State& state) {
+  Scene b = standing_scene();
+  const Model& m = *b.model;
+  auto a = make_data(m);
+  set_root_mode(*a, RootMode::kinematic);
+  StepInputs in_a = make_inputs(m);
+  for (int i = 0; i < m.nbody; ++i) {
+    in_a.kp[static_cast<std::size_t>(i)] *= 10.0;
+    b.inputs.kp[static_cast<std::size_t>(i)] *= 0.1;
+  }
+  for (auto _ : state) {
+    step(m, *a, in_a);
+    for (int k = 6; k < m.nv; ++k) {
+      const auto ku = static_cast<std::size_t>(k);
+      b.inputs.tau_ff[ku] = a->tau_pd[ku] + a->tau_ff[ku];
+    }
+    step(m, *b.data, b.inputs);
+    benchmark::DoNotOptimize(b.data->qpos.data());
+  }
+}
+BENCHMARK(BM_DualTick);
+
+void BM_MujocoStep(benchmark::State& state) {
+  const auto model = standing_humanoid();
+  auto data = make_data(*model);
+  add_cube_on_hand(*model, *data);
+  MjcfOptions opt;
+  opt.drives_as_springs = true;
+  opt.objects_from = data.get();
+  char path[] = "/tmp/tonus-bench-XXXXXX.xml";
+  const int fd = mkstemps(path, 4);
+  if (fd < 0) {
+    state.SkipWithError("no temporary file");
+    return;
+  }
+  close(fd);
+  std::ofstream(path) << to_mjcf(*model, opt);
+  char err[1024] = {0};
+  mjModel* mm = mj_loadXML(path, nullptr, err, sizeof err);
+  std::remove(path);
+  if (mm == nullptr) {
+    state.SkipWithError(err);
+    return;
+  }
+  mjData* md = mj_makeData(mm);
+  for (int i = 0; i < kSettleSteps; ++i) mj_step(mm, md);
+  for (auto _ : state) {
+    mj_step(mm, md);
+    benchmark::DoNotOptimize(md->qpos);
+  }
+  state.counters["contacts"] = md->ncon;
+  mj_deleteData(md);
+  mj_deleteModel(mm);
+}
+BENCHMARK(BM_MujocoStep);
+
+// Forwards to the reporter the flags ask for and keeps each run's time.
+class RatioReporter : public benchmark::BenchmarkReporter {
+ public:
+  explicit RatioReporter(bool json) {
+    if (json) {
+      inner_ = std::make_unique<benchmark::JSONReporter>();
+    } else {
+      inner_ = std::make_unique<benchmark::ConsoleReporter>(isatty(STDOUT_FILENO) != 0
+                                                                ? benchmark::ConsoleReporter::OO_ColorTabular
+                                                                : benchmark::ConsoleReporter::OO_Tabular);
+    }
+    inner_->SetOutputStream(&std::cout);
+    inner_->SetErrorStream(&std::cerr);
+  }
+  bool ReportContext(const Context& c) override { return inner_->ReportContext(c); }
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const Run& r : runs) {
+      if (r.run_type == Run::RT_Iteration && !r.error_occurred && r.repetition_index <= 0) {
+        const auto n = static_cast<double>(r.iterations);
+        times_[r.run_name.function_name] = {r.real_accumulated_time / n, r.cpu_accumulated_time / n};
+      }
+    }
+    inner_->ReportRuns(runs);
+  }
+  void Finalize() override { inner_->Finalize(); }
+  struct Times {
+    double real_s = 0.0, cpu_s = 0.0;
+  };
+  [[nodiscard]] Times times(const std::string& name) const {
+    const auto it = times_.find(name);
+    return it == times_.end() ? Times{} : it->second;
+  }
+
+ private:
+  std::unique_ptr<benchmark::BenchmarkReporter> inner_;
+  std::map<std::string, Times> times_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  bool json = false;
+  for (int i = 1; i < argc; ++i) json = json || std::string(argv[i]) == "--benchmark_format=json";
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  RatioReporter reporter(json);
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  benchmark::Shutdown();
+  std::ostream& out = json ? std::cerr : std::cout;
+  const auto ours = reporter.times("BM_HumanoidStep"), dual = reporter.times("BM_DualTick");
+  const auto mujoco = reporter.times("BM_MujocoStep");
+  if (ours.real_s > 0.0 && mujoco.real_s > 0.0) {
+    out << "\nstep time, tonus / MuJoCo (goal: at most 2, i.e. at least 0.5x MuJoCo's speed):\n"
+        << "  wall: " << ours.real_s / mujoco.real_s << " (" << ours.real_s * 1e6 << " us vs " << mujoco.real_s * 1e6
+        << " us)\n"
+        << "  cpu:  " << ours.cpu_s / mujoco.cpu_s << " (" << ours.cpu_s * 1e6 << " us vs " << mujoco.cpu_s * 1e6
+        << " us)\n";
+    if (dual.real_s > 0.0) {
+      out << "dual tick (two steps): " << dual.real_s * 1e6 << " us wall = " << dual.real_s / mujoco.real_s
+          << " MuJoCo steps\n";
+    }
+  }
+  out << "memory: sizeof(Model) = " << sizeof(Model) << " B, sizeof(Data) = " << sizeof(Data) << " B\n";
+  return 0;
+}
