@@ -40,6 +40,11 @@ inline constexpr double kParallelCos = 0.999799979995999;  // sqrt(1 - kParallel
 inline constexpr double kFaceOverFaceRel = 0.02;
 inline constexpr double kEdgeOverFaceRel = 0.05;
 inline constexpr double kPreferAbs = 1e-5;
+// An edge axis within 2 degrees of the best face normal never wins: the
+// faces are nearly parallel (a slightly tilted cube on a palm, its low corner
+// over the palm's edge), and clipping the face puts points at the edge with
+// their true gaps, where an edge-edge contact would give a single point.
+inline constexpr double kEdgeFaceCos = 0.99939082701909576;  // cos(2 degrees)
 
 // Candidate points of one pair before the reduction to kMaxPointsPerPair.
 class Candidates {

@@ -236,9 +236,19 @@ void box_box(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, Can
   }
 
   // Overlapping (or touching): the least-penetration axis, faces preferred.
-  if (ax.edge_i >= 0 && ax.edge > face_sep + kEdgeOverFaceRel * std::abs(face_sep) + abs_tol) {
-    // Edge-edge: the edge of A supporting towards B against the edge of B
-    // supporting towards A, each along its axis of the cross product.
+  const Vec3 face_dir = ref_is_b ? Vec3(r.col(ref_axis)) : Vec3(Vec3::Unit(ref_axis));  // A's frame
+  const bool edge_wins = ax.edge_i >= 0 && ax.edge > face_sep + kEdgeOverFaceRel * std::abs(face_sep) + abs_tol &&
+                         std::abs(ax.edge_dir.dot(face_dir)) < kEdgeFaceCos;
+  const std::size_t n = edge_wins ? 0 : clip(ref_is_b, ref_axis, ref_side);
+  const Vec3 normal = ref_normal(ref_is_b, ref_axis, ref_side);
+  if (n > 0) {
+    add_face_contacts(pts, n, normal, ref_is_b, -std::numeric_limits<double>::infinity(), out);
+    return;
+  }
+  if (ax.edge_i >= 0) {
+    // Edge-edge (the edge axis won, or the preferred face's clip was empty):
+    // the edge of A supporting towards B against the edge of B supporting
+    // towards A, each along its axis of the cross product.
     const Vec3 l = t.dot(ax.edge_dir) < 0.0 ? Vec3(-ax.edge_dir) : ax.edge_dir;  // A to B
     const Vec3 lb = r.transpose() * l;
     Vec3 mid_a = Vec3::Zero();
@@ -252,8 +262,8 @@ void box_box(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, Can
     const Vec3 b0 = t + r * (mid_b - ext_b);
     const Vec3 b1 = t + r * (mid_b + ext_b);
     const ClosestPair cp = closest_segments(mid_a - ext_a, mid_a + ext_a, b0, b1);
-    const Vec3 n = -l;  // from B to A
-    const double dist = (cp.first - cp.second).dot(n);
+    const Vec3 n_ba = -l;  // from B to A
+    const double dist = (cp.first - cp.second).dot(n_ba);
     if (std::abs(r(ax.edge_i, ax.edge_j)) >= kParallelCos) {
       // Nearly parallel edges: the two ends of their overlap along A's edge.
       const double lo = std::max(-ha[ax.edge_i], std::min(b0[ax.edge_i], b1[ax.edge_i]));
@@ -263,23 +273,17 @@ void box_box(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, Can
         Vec3 x = mid_a;
         x[ax.edge_i] = s;
         const Vec3 y = closest_on_segment(b0, b1, x);
-        out.add_from_b(pa.apply(y), pa.rot * n, (x - y).dot(n));
+        out.add_from_b(pa.apply(y), pa.rot * n_ba, (x - y).dot(n_ba));
       }
     }
     if (out.size() == 0 || out.min_dist() > dist + kSameRel * out.scale()) {
-      out.add_from_b(pa.apply(cp.second), pa.rot * n, dist);
+      out.add_from_b(pa.apply(cp.second), pa.rot * n_ba, dist);
     }
     return;
   }
-  const std::size_t n = clip(ref_is_b, ref_axis, ref_side);
-  const Vec3 normal = ref_normal(ref_is_b, ref_axis, ref_side);
-  if (n > 0) {
-    add_face_contacts(pts, n, normal, ref_is_b, -std::numeric_limits<double>::infinity(), out);
-    return;
-  }
-  // Incident face entirely outside the reference face's prism (possible only
-  // when a face axis was preferred over a slightly better edge axis): the
-  // incident corner deepest along the reference normal.
+  // No edge axis and the incident face entirely outside the reference
+  // face's prism (touching within rounding): the incident corner deepest
+  // along the reference normal.
   const Pose& ref = ref_is_b ? pb : pa;
   const Pose& inc = ref_is_b ? pa : pb;
   const Vec3& ref_half = ref_is_b ? hb : ha;

@@ -154,9 +154,15 @@ void capsule_box(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb,
   }
 
   const double prefer = kEdgeOverFaceRel * std::abs(face_sep) + kPreferAbs * half.minCoeff();
-  if (edge >= 0 && edge_sep > face_sep + prefer) {
-    // Edge contact: the segment against the box edge along `edge` that
-    // supports the box towards the capsule.
+  const bool edge_wins = edge >= 0 && edge_sep > face_sep + prefer && std::abs(edge_dir[face]) < kEdgeFaceCos;
+  // Face contact: the part of the core over the face, at its (negative) heights.
+  const double side = sign_of(c[face]);
+  const double any_height = -std::numeric_limits<double>::infinity();
+  if (!edge_wins && add_face_points(pb, half, p0, p1, face, side, r, any_height, out)) return;
+  if (edge >= 0) {
+    // Edge contact (the edge axis won, or the core is not over the face):
+    // the segment against the box edge along `edge` that supports the box
+    // towards the capsule.
     const Vec3 l = c.dot(edge_dir) < 0.0 ? Vec3(-edge_dir) : edge_dir;
     Vec3 mid = Vec3::Zero();
     for (int j = 0; j < 3; ++j) {
@@ -178,12 +184,8 @@ void capsule_box(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb,
     if (out.size() == 0 || out.min_dist() > dist + kSameRel * out.scale()) add_local(pb, cp.second, l, dist, out);
     return;
   }
-  // Face contact: the part of the core over the face, at its (negative) heights.
-  const double side = sign_of(c[face]);
-  const double any_height = -std::numeric_limits<double>::infinity();
-  if (add_face_points(pb, half, p0, p1, face, side, r, any_height, out)) return;
-  // Only grazing the box outside that face's prism (touching within
-  // rounding): the closest pair, along the face normal.
+  // No edge axis and the core only grazing the box outside that face's prism
+  // (touching within rounding): the closest pair, along the face normal.
   const ClosestPair cp = closest_segment_box(p0, p1, half);
   Vec3 normal = Vec3::Zero();
   normal[face] = side;

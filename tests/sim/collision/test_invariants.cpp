@@ -167,7 +167,7 @@ void check_config(const Config& c, Rng& rng, Stats& st) {
 
 }  // namespace
 
-TEST_CASE("random configurations of every pair: invariants and the true signed distance") {
+TEST_CASE("collision: random configurations of every pair: invariants and the true signed distance") {
   const std::array<std::pair<ShapeType, ShapeType>, 9> pairs = {{
       {ShapeType::sphere, ShapeType::sphere},
       {ShapeType::sphere, ShapeType::capsule},

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <cstring>
 #include <limits>
@@ -75,7 +76,8 @@ class MujocoPair {
 
   // Places geom i (in model order) and sets its size and margin.
   void set(int i, const Shape& s, const Pose& p, double margin) {
-    mjtNum* size = model_->geom_size + 3 * i;
+    const std::ptrdiff_t g = i;  // pointer offsets in a wide type
+    mjtNum* size = model_->geom_size + 3 * g;
     switch (s.type) {
       case ShapeType::sphere: size[0] = s.radius_m; break;
       case ShapeType::capsule:
@@ -93,11 +95,11 @@ class MujocoPair {
     if (s.type == ShapeType::plane) {
       // World geom: its pose is the model's geom offset.
       model_->geom_sameframe[i] = 0;
-      for (int k = 0; k < 3; ++k) model_->geom_pos[3 * i + k] = p.pos[k];
-      model_->geom_quat[4 * i] = q.w();
-      model_->geom_quat[4 * i + 1] = q.x();
-      model_->geom_quat[4 * i + 2] = q.y();
-      model_->geom_quat[4 * i + 3] = q.z();
+      for (int k = 0; k < 3; ++k) model_->geom_pos[3 * g + k] = p.pos[k];
+      model_->geom_quat[4 * g] = q.w();
+      model_->geom_quat[4 * g + 1] = q.x();
+      model_->geom_quat[4 * g + 2] = q.y();
+      model_->geom_quat[4 * g + 3] = q.z();
     } else {
       const int adr = model_->jnt_qposadr[model_->body_jntadr[model_->geom_bodyid[i]]];
       mjtNum* qpos = data_->qpos + adr;
@@ -115,9 +117,11 @@ class MujocoPair {
   // The pose MuJoCo ended up with for geom i (what our side is given too).
   [[nodiscard]] Pose pose(int i) const {
     Pose p;
-    for (int k = 0; k < 3; ++k) p.pos[k] = data_->geom_xpos[3 * i + k];
+    const std::ptrdiff_t g = i;  // pointer offsets in a wide type
+    for (int k = 0; k < 3; ++k) p.pos[k] = data_->geom_xpos[3 * g + k];
+    const mjtNum* xmat = data_->geom_xmat + 9 * g;  // row major
     for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) p.rot(r, c) = data_->geom_xmat[9 * i + 3 * r + c];
+      for (int c = 0; c < 3; ++c) p.rot(r, c) = xmat[(3 * r) + c];
     }
     return p;
   }
@@ -193,7 +197,7 @@ bool mujoco_exact_here(const Shape& s1, const Pose& p1, const Shape& s2, const P
 
 }  // namespace
 
-TEST_CASE("MuJoCo 2.2.2: normal convention (sphere resting on the ground plane)") {
+TEST_CASE("collision: MuJoCo 2.2.2: normal convention (sphere resting on the ground plane)") {
   MujocoPair mj(ShapeType::plane, ShapeType::sphere);
   mj.set(0, Shape::plane(), Pose{}, 0.0);
   mj.set(1, Shape::sphere(0.1), Pose{Vec3(0.0, 0.0, 0.09), Mat3::Identity()}, 0.0);
@@ -212,7 +216,7 @@ TEST_CASE("MuJoCo 2.2.2: normal convention (sphere resting on the ground plane)"
   CHECK(out[0].dist_m == doctest::Approx(c.dist));
 }
 
-TEST_CASE("MuJoCo 2.2.2: minimum signed distance and deepest normal on random configurations") {
+TEST_CASE("collision: MuJoCo 2.2.2: minimum signed distance and deepest normal on random configurations") {
   const std::array<std::pair<ShapeType, ShapeType>, 9> pairs = {{
       {ShapeType::sphere, ShapeType::sphere},
       {ShapeType::sphere, ShapeType::capsule},
