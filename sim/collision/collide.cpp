@@ -1,6 +1,7 @@
 // collide(): input checks, canonical pair order, dispatch, reduction.
 #include "tonus/sim/collision.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 

@@ -221,7 +221,7 @@ void box_box(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, Can
       const double lo = std::max(-ha[edge_a], std::min(b0, b1));
       const double hi = std::min(ha[edge_a], std::max(b0, b1));
       for (const double s : {lo, hi}) {
-        if (s == hi && hi - lo <= tol) break;  // a single point
+        if (lo > hi || (s == hi && hi - lo <= tol)) break;  // no overlap, or a single point
         Vec3 x = mid_a;
         x[edge_a] = s;
         const Vec3 y = t + r * clamp_to_box(r.transpose() * (x - t), hb);
@@ -269,7 +269,7 @@ void box_box(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, Can
       const double lo = std::max(-ha[ax.edge_i], std::min(b0[ax.edge_i], b1[ax.edge_i]));
       const double hi = std::min(ha[ax.edge_i], std::max(b0[ax.edge_i], b1[ax.edge_i]));
       for (const double s : {lo, hi}) {
-        if (s == hi && hi - lo <= kSameRel * out.scale()) break;  // a single point
+        if (lo > hi || (s == hi && hi - lo <= kSameRel * out.scale())) break;  // no overlap, or a single point
         Vec3 x = mid_a;
         x[ax.edge_i] = s;
         const Vec3 y = closest_on_segment(b0, b1, x);

@@ -386,6 +386,21 @@ TEST_CASE("collision: box-box") {
     check_point(pts[0], {0.105, 0.11, 0.115}, Vec3(1, 2, 3) / std::sqrt(14.0), 0.01 * std::sqrt(14.0));
     CHECK(contacts(c, at(0.21, 0.22, 0.23), c, at(0, 0, 0), 0.035).empty());
   }
+  SUBCASE("parallel edges alongside: both ends of the overlap; just past each other: the corners") {
+    // Vertical edges at (0.1, 0.1) and (0.11, 0.11): 0.01 sqrt2 apart.
+    const Shape c = Shape::box({0.1, 0.1, 0.1});
+    const Vec3 n = Vec3(1, 1, 0) / kSqrt2;
+    auto pts = contacts(c, at(0.21, 0.21, 0.05), c, at(0, 0, 0), 0.02);  // overlap z in [-0.05, 0.1]
+    REQUIRE(pts.size() == 2);
+    CHECK(has_point(pts, {0.105, 0.105, -0.05}));
+    CHECK(has_point(pts, {0.105, 0.105, 0.1}));
+    for (const ContactPoint& p : pts) check_point(p, p.pos, n, 0.01 * kSqrt2);
+    // 1e-4 past the end: corner to corner, the gap direction barely tilted.
+    pts = contacts(c, at(0.21, 0.21, 0.2001), c, at(0, 0, 0), 0.02);
+    REQUIRE(pts.size() == 1);
+    const Vec3 gap(0.01, 0.01, 0.0001);
+    check_point(pts[0], Vec3(0.105, 0.105, 0.10005), gap.normalized(), gap.norm());
+  }
   SUBCASE("faces overlapping at a corner, apart: the overlap square") {
     const Shape c = Shape::box({0.1, 0.1, 0.1});
     const auto pts = contacts(c, at(0.15, 0.15, 0.205), c, at(0, 0, 0), 0.01);
