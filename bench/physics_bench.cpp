@@ -150,10 +150,16 @@ class RatioReporter : public benchmark::BenchmarkReporter {
   }
   bool ReportContext(const Context& c) override { return inner_->ReportContext(c); }
   void ReportRuns(const std::vector<Run>& runs) override {
+    // One time per benchmark: the mean over repetitions when there are several, else the run.
     for (const Run& r : runs) {
-      if (r.run_type == Run::RT_Iteration && !r.error_occurred && r.repetition_index <= 0) {
+      if (r.error_occurred) continue;
+      const std::string& name = r.run_name.function_name;
+      if (r.run_type == Run::RT_Aggregate && r.aggregate_name == "mean") {
+        times_[name] = {r.GetAdjustedRealTime() * unit_seconds(r.time_unit),
+                        r.GetAdjustedCPUTime() * unit_seconds(r.time_unit), true};
+      } else if (r.run_type == Run::RT_Iteration && !times_[name].from_mean && r.repetition_index <= 0) {
         const auto n = static_cast<double>(r.iterations);
-        times_[r.run_name.function_name] = {r.real_accumulated_time / n, r.cpu_accumulated_time / n};
+        times_[name] = {r.real_accumulated_time / n, r.cpu_accumulated_time / n, false};
       }
     }
     inner_->ReportRuns(runs);
@@ -161,7 +167,17 @@ class RatioReporter : public benchmark::BenchmarkReporter {
   void Finalize() override { inner_->Finalize(); }
   struct Times {
     double real_s = 0.0, cpu_s = 0.0;
+    bool from_mean = false;
   };
+  static double unit_seconds(benchmark::TimeUnit u) {
+    switch (u) {
+      case benchmark::kNanosecond: return 1e-9;
+      case benchmark::kMicrosecond: return 1e-6;
+      case benchmark::kMillisecond: return 1e-3;
+      case benchmark::kSecond: return 1.0;
+    }
+    return 1e-9;
+  }
   [[nodiscard]] Times times(const std::string& name) const {
     const auto it = times_.find(name);
     return it == times_.end() ? Times{} : it->second;
