@@ -65,7 +65,7 @@ Scene standing_scene() {
 
 void BM_HumanoidStep(benchmark::State& state) {
   Scene s = standing_scene();
-  for (auto _ : state) {
+  for (auto _ : state) {  // NOLINT(clang-analyzer-deadcode.DeadStores): Google Benchmark's loop idiom
     step(*s.model, *s.data, s.inputs);
     benchmark::DoNotOptimize(s.data->qpos.data());
   }
@@ -88,7 +88,7 @@ void BM_DualTick(benchmark::State& state) {
     in_a.kp[static_cast<std::size_t>(i)] *= 10.0;
     b.inputs.kp[static_cast<std::size_t>(i)] *= 0.1;
   }
-  for (auto _ : state) {
+  for (auto _ : state) {  // NOLINT(clang-analyzer-deadcode.DeadStores): Google Benchmark's loop idiom
     step(m, *a, in_a);
     for (int k = 6; k < m.nv; ++k) {
       const auto ku = static_cast<std::size_t>(k);
@@ -124,7 +124,7 @@ void BM_MujocoStep(benchmark::State& state) {
   }
   mjData* md = mj_makeData(mm);
   for (int i = 0; i < kSettleSteps; ++i) mj_step(mm, md);
-  for (auto _ : state) {
+  for (auto _ : state) {  // NOLINT(clang-analyzer-deadcode.DeadStores): Google Benchmark's loop idiom
     mj_step(mm, md);
     benchmark::DoNotOptimize(md->qpos);
   }

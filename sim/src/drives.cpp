@@ -325,7 +325,8 @@ void release_drive_rows(const Model& model, Data& data) {
     if (!data.drive_in_rows[i]) continue;
     const Body& b = model.bodies[i];
     double norm2 = 0.0;
-    for (size_t d = static_cast<size_t>(b.dof_adr); d < static_cast<size_t>(b.dof_adr + b.dof_num); ++d) {
+    for (size_t d = static_cast<size_t>(b.dof_adr); d < static_cast<size_t>(b.dof_adr) + static_cast<size_t>(b.dof_num);
+         ++d) {
       const double total = data.tau_pd[d] + data.tau_ff[d];
       norm2 += total * total;
     }

@@ -27,7 +27,7 @@ void inverse_dynamics(const Model& model, Data& data, std::span<const double> qa
     const Body& b = model.bodies[i];
     Vec6 a = b.parent >= 0 ? acc[static_cast<std::size_t>(b.parent)] : a_world;
     for (int k = 0; k < b.dof_num; ++k) {
-      const auto d = static_cast<std::size_t>(b.dof_adr + k);
+      const auto d = static_cast<std::size_t>(b.dof_adr) + static_cast<std::size_t>(k);
       a += data.cdof_dot[d] * data.qvel[d] + data.cdof[d] * qacc[d];
     }
     acc[i] = a;
@@ -37,7 +37,7 @@ void inverse_dynamics(const Model& model, Data& data, std::span<const double> qa
   for (std::size_t i = nbody; i-- > 0;) {
     const Body& b = model.bodies[i];
     for (int k = 0; k < b.dof_num; ++k) {
-      const auto d = static_cast<std::size_t>(b.dof_adr + k);
+      const auto d = static_cast<std::size_t>(b.dof_adr) + static_cast<std::size_t>(k);
       tau[d] = data.cdof[d].dot(force[i]);
     }
     if (b.parent >= 0) force[static_cast<std::size_t>(b.parent)] += force[i];
@@ -60,9 +60,10 @@ void mass_matrix(const Model& model, Data& data) {
     const auto ku = static_cast<std::size_t>(k);
     const Vec6 f = composite[static_cast<std::size_t>(model.dof_body[ku])].apply(data.cdof[ku]);
     for (int j = k; j >= 0; j = model.dof_parent[static_cast<std::size_t>(j)]) {
-      data.mass[static_cast<std::size_t>(k * nv + j)] = data.cdof[static_cast<std::size_t>(j)].dot(f);
+      data.mass[ku * static_cast<std::size_t>(nv) + static_cast<std::size_t>(j)] =
+          data.cdof[static_cast<std::size_t>(j)].dot(f);
     }
-    data.mass[static_cast<std::size_t>(k * nv + k)] +=
+    data.mass[ku * static_cast<std::size_t>(nv) + ku] +=
         model.bodies[static_cast<std::size_t>(model.dof_body[ku])].armature;
   }
 }

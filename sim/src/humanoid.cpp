@@ -106,10 +106,10 @@ Vec3 hinge_axis(Bone b) {
   switch (b) {
     case Bone::LeftLowerArm: return -Vec3::UnitZ();  // forearm (+Y) swings forward (+X)
     case Bone::RightLowerArm: return Vec3::UnitZ();  // forearm (-Y) swings forward (+X)
-    case Bone::LeftLowerLeg:
-    case Bone::RightLowerLeg: return Vec3::UnitY();  // shank (-Z) swings back (-X)
-    case Bone::LeftToes:
-    case Bone::RightToes: return Vec3::UnitY();  // positive curls the toes down
+    case Bone::LeftLowerLeg:                         // shank (-Z) swings back (-X)
+    case Bone::RightLowerLeg:
+    case Bone::LeftToes:  // positive curls the toes down
+    case Bone::RightToes: return Vec3::UnitY();
     default: return Vec3::UnitX();
   }
 }

@@ -4,7 +4,9 @@
 
 namespace tonus::sim::ltdl {
 namespace {
-inline std::size_t at(int r, int c, int nv) { return static_cast<std::size_t>(r * nv + c); }
+inline std::size_t at(int r, int c, int nv) {
+  return static_cast<std::size_t>(r) * static_cast<std::size_t>(nv) + static_cast<std::size_t>(c);
+}
 inline int up(std::span<const int> parent, int k) { return parent[static_cast<std::size_t>(k)]; }
 }  // namespace
 

@@ -49,7 +49,7 @@ bool check_inertia(Checker& c, const std::string& where, const Mat3& inertia) {
     return c.fail(where, "inertia is not symmetric");
   }
   const Eigen::SelfAdjointEigenSolver<Mat3> eig(inertia);
-  const Vec3 ev = eig.eigenvalues();  // ascending
+  const Vec3& ev = eig.eigenvalues();  // ascending
   if (!(ev(0) > 0.0)) return c.fail(where, "inertia is not positive definite");
   // A real mass distribution obeys the triangle inequality of principal moments.
   if (ev(0) + ev(1) < ev(2) * (1.0 - 1e-9)) return c.fail(where, "inertia violates the triangle inequality");
@@ -150,7 +150,7 @@ int ModelBuilder::add_body(BodySpec spec) {
   return static_cast<int>(bodies_.size()) - 1;
 }
 
-void ModelBuilder::add_geom(GeomSpec spec) { geoms_.push_back(spec); }
+void ModelBuilder::add_geom(const GeomSpec& spec) { geoms_.push_back(spec); }
 
 ModelBuilder& ModelBuilder::timestep(double dt_s) {
   timestep_s_ = dt_s;
@@ -257,7 +257,7 @@ BuildResult ModelBuilder::build() const {
     b.qpos_num = joint_qpos(s.joint);
     const int parent_last = s.parent >= 0 ? m->bodies[static_cast<std::size_t>(s.parent)].last_path_dof : -1;
     for (int k = 0; k < b.dof_num; ++k) {
-      const auto d = static_cast<std::size_t>(dof + k);
+      const auto d = static_cast<std::size_t>(dof) + static_cast<std::size_t>(k);
       m->dof_body[d] = static_cast<int>(i);
       m->dof_parent[d] = k == 0 ? parent_last : dof + k - 1;
       m->dof_kp[d] = s.drive.kp;

@@ -282,7 +282,7 @@ TEST_CASE("more contact points than the capacity: counted, dropped, never a cras
   ObjectSpec box;
   box.shape = Shape::box(Vec3::Constant(0.05));
   for (std::size_t i = 0; i < kMaxObjects; ++i) {
-    box.pos = Vec3(1.0 + 0.2 * static_cast<double>(i % 4), 0.2 * static_cast<double>(i / 4), 0.05);
+    box.pos = Vec3(1.0 + 0.2 * static_cast<double>(i % 4), 0.2 * static_cast<double>(i >> 2U), 0.05);
     REQUIRE(add_object(*data, box).error == ObjectError::none);
   }
   const StepInputs in = make_inputs(*model);

@@ -49,7 +49,8 @@ void set_gains(const Model& m, Data& d, StepInputs& in, double kp, double zeta) 
     const Body& b = m.bodies[static_cast<std::size_t>(i)];
     double inertia = 0.0;
     for (int k = b.dof_adr; k < b.dof_adr + b.dof_num; ++k) {
-      inertia = std::max(inertia, d.mass[static_cast<std::size_t>(k * m.nv + k)]);
+      inertia = std::max(
+          inertia, d.mass[static_cast<std::size_t>(k) * static_cast<std::size_t>(m.nv) + static_cast<std::size_t>(k)]);
     }
     in.kp[static_cast<std::size_t>(i)] = kp;
     in.kd[static_cast<std::size_t>(i)] = zeta * 2.0 * std::sqrt(kp * inertia);

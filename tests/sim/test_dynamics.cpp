@@ -40,7 +40,8 @@ Eigen::MatrixXd dense_mass(const Model& m, const Data& d) {
   M.setZero();
   for (int k = 0; k < m.nv; ++k) {
     for (int j = k; j >= 0; j = m.dof_parent[static_cast<std::size_t>(j)]) {
-      M(k, j) = M(j, k) = d.mass[static_cast<std::size_t>(k * m.nv + j)];
+      M(k, j) = M(j, k) =
+          d.mass[static_cast<std::size_t>(k) * static_cast<std::size_t>(m.nv) + static_cast<std::size_t>(j)];
     }
   }
   return M;

@@ -25,6 +25,8 @@ void count() {
 }
 }  // namespace
 
+// The linker's --wrap names are reserved identifiers by construction.
+// NOLINTBEGIN(bugprone-reserved-identifier)
 extern "C" {
 void* __real_malloc(std::size_t n);
 void* __real_calloc(std::size_t n, std::size_t s);
@@ -52,6 +54,7 @@ void* __wrap_aligned_alloc(std::size_t a, std::size_t n) {
   return __real_aligned_alloc(a, n);
 }
 }
+// NOLINTEND(bugprone-reserved-identifier)
 
 void* operator new(std::size_t n) {
   count();

@@ -90,7 +90,7 @@ TEST_CASE("the exported humanoid loads in MuJoCo with the same masses, inertias 
     const Body& b = model->bodies[static_cast<std::size_t>(i)];
     CHECK(mj.m()->body_mass[i + 1] == doctest::Approx(b.mass_kg).epsilon(1e-12));
     // MuJoCo stores principal moments; their sum is the trace, frame-free.
-    const double* pi = mj.m()->body_inertia + 3 * (i + 1);
+    const double* pi = mj.m()->body_inertia + 3 * static_cast<std::ptrdiff_t>(i + 1);
     CHECK(pi[0] + pi[1] + pi[2] == doctest::Approx(b.inertia.trace()).epsilon(1e-9));
   }
 }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <vector>
 
@@ -74,7 +75,7 @@ int run_physics_demo(const PhysicsDemoOptions& opt) {
   ObjectHandle ball{};
   double ball_in = 0.0, ball_out = 0.0;
   std::vector<double> cost_us;
-  const auto steps = static_cast<int>(opt.seconds / dt + 0.5);
+  const auto steps = static_cast<int>(std::lround(opt.seconds / dt));
   cost_us.reserve(static_cast<std::size_t>(steps));
   int diverged = 0;
   double lowest_hips = data->qpos[2];

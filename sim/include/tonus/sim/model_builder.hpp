@@ -44,7 +44,7 @@ class ModelBuilder {
  public:
   // Bodies must be added parent before child. Returns the body's index.
   int add_body(BodySpec spec);
-  void add_geom(GeomSpec spec);
+  void add_geom(const GeomSpec& spec);
 
   ModelBuilder& timestep(double dt_s);
   ModelBuilder& integrator(Integrator i);
