@@ -55,6 +55,8 @@ void apply_impulses(const Model& model, Data& data);
 // q (+) dt v for the articulation and the objects; kinematic roots snap to their reference.
 void integrate(const Model& model, Data& data, const StepInputs& inputs);
 void snap_kinematic_root(const Model& model, Data& data, const StepInputs& inputs);
+void integrate_objects(Data& data, const std::array<Vec3, kMaxObjects>& lin, const std::array<Vec3, kMaxObjects>& ang,
+                       double dt_s);
 
 // Contact forces for the caller (impulse / dt) and warm-start memory.
 void report_contacts(const Model& model, Data& data);

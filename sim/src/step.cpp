@@ -50,6 +50,19 @@ void save_state(const Model& model, Data& data) {
 
 namespace detail {
 
+void integrate_objects(Data& data, const std::array<Vec3, kMaxObjects>& lin, const std::array<Vec3, kMaxObjects>& ang,
+                       double dt_s) {
+  for (size_t i = 0; i < kMaxObjects; ++i) {
+    Object& o = data.objects[i];
+    if (!o.active) continue;
+    o.lin_vel = lin[i];
+    o.ang_vel = ang[i];
+    o.pos += dt_s * o.lin_vel;
+    o.quat = (quat_exp(o.ang_vel * dt_s) * o.quat).normalized();  // world-frame angular velocity: left multiply
+    o.force.setZero();
+  }
+}
+
 void snap_kinematic_root(const Model& model, Data& data, const StepInputs& in) {
   if (model.bodies[0].joint != JointType::free || data.root_mode != RootMode::kinematic) return;
   const double n = in.root_quat.norm();
@@ -72,15 +85,7 @@ void integrate(const Model& model, Data& data, const StepInputs& in) {
   std::copy_n(data.qvel_next.begin(), nv, data.qvel.begin());
   integrate_positions(model, data.qpos, data.qvel, dt);
   snap_kinematic_root(model, data, in);
-  for (size_t i = 0; i < kMaxObjects; ++i) {
-    Object& o = data.objects[i];
-    if (!o.active) continue;
-    o.lin_vel = data.obj_lin_next[i];
-    o.ang_vel = data.obj_ang_next[i];
-    o.pos += dt * o.lin_vel;
-    o.quat = (quat_exp(o.ang_vel * dt) * o.quat).normalized();  // world-frame angular velocity: left multiply
-    o.force.setZero();
-  }
+  integrate_objects(data, data.obj_lin_next, data.obj_ang_next, dt);
 }
 
 }  // namespace detail
@@ -217,15 +222,7 @@ bool step_rk4(const Model& model, Data& data, const StepInputs& inputs) {
   detail::snap_kinematic_root(model, data, inputs);
   // Objects: free flight (an rk4 model has no contacts).
   detail::objects_free_velocity(model, data);
-  for (size_t i = 0; i < kMaxObjects; ++i) {
-    Object& o = data.objects[i];
-    if (!o.active) continue;
-    o.lin_vel = data.obj_lin_free[i];
-    o.ang_vel = data.obj_ang_free[i];
-    o.pos += h * o.lin_vel;
-    o.quat = (quat_exp(o.ang_vel * h) * o.quat).normalized();
-    o.force.setZero();
-  }
+  detail::integrate_objects(data, data.obj_lin_free, data.obj_ang_free, h);
   data.ncon = 0;
   return true;
 }

@@ -43,6 +43,25 @@ Mujoco::~Mujoco() {
   if (model_ != nullptr) mj_deleteModel(model_);
 }
 
+void random_joint_pose(const Model& model, std::span<double> qpos, unsigned seed, double spread) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0.0, spread);
+  std::uniform_real_distribution<double> inside(0.25, 0.75);
+  for (int i = 1; i < model.nbody; ++i) {
+    const Body& b = model.bodies[static_cast<std::size_t>(i)];
+    const auto q = static_cast<std::size_t>(b.qpos_adr);
+    if (b.joint == JointType::ball) {
+      const Quat r = quat_exp(Vec3(n(rng), n(rng), n(rng)));
+      qpos[q] = r.w();
+      qpos[q + 1] = r.x();
+      qpos[q + 2] = r.y();
+      qpos[q + 3] = r.z();
+    } else if (b.joint == JointType::hinge) {
+      qpos[q] = b.limit.enabled ? b.limit.lower_rad + inside(rng) * (b.limit.upper_rad - b.limit.lower_rad) : n(rng);
+    }
+  }
+}
+
 StepInputs passive_inputs(const Model& model) {
   StepInputs in = make_inputs(model);
   in.kp.fill(0.0);

@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <random>
+#include <span>
 #include <string>
 
 #include "tonus/sim/humanoid.hpp"
@@ -35,6 +36,11 @@ class Mujoco {
   mjData* data_ = nullptr;
   std::string error_;
 };
+
+// A random configuration of the joints (not the root) into `qpos`: ball
+// joints rotated by N(0, spread) per axis, hinges inside their range when
+// they have one (else N(0, spread)). Seeded, reproducible.
+void random_joint_pose(const Model& model, std::span<double> qpos, unsigned seed, double spread);
 
 // Inputs with every drive off (kp = kd = 0), holding nothing.
 StepInputs passive_inputs(const Model& model);

@@ -23,21 +23,7 @@ Features drives_only() {
 
 // A target pose some way from the rest pose, inside the joint ranges.
 void target_pose(const Model& m, StepInputs& in, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> n(0.0, 0.25);
-  for (int i = 1; i < m.nbody; ++i) {
-    const Body& b = m.bodies[static_cast<std::size_t>(i)];
-    auto q = in.target_qpos.begin() + b.qpos_adr;
-    if (b.joint == JointType::ball) {
-      const Quat r = quat_exp(Vec3(n(rng), n(rng), n(rng)));
-      q[0] = r.w();
-      q[1] = r.x();
-      q[2] = r.y();
-      q[3] = r.z();
-    } else if (b.joint == JointType::hinge) {
-      q[0] = 0.5 * (b.limit.lower_rad + b.limit.upper_rad);
-    }
-  }
+  test::random_joint_pose(m, in.target_qpos, seed, 0.25);
 }
 
 // Every drive at stiffness kp, damping at `zeta` times critical for the

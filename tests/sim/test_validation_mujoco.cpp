@@ -29,23 +29,7 @@ void random_velocities(const Model& m, Data& d, unsigned seed, double scale = 1.
   for (int k = 0; k < m.nv; ++k) d.qvel[static_cast<std::size_t>(k)] = n(rng);
 }
 
-void random_pose(const Model& m, Data& d, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> n(0.0, 0.3);
-  for (int i = 1; i < m.nbody; ++i) {
-    const Body& b = m.bodies[static_cast<std::size_t>(i)];
-    auto q = d.qpos.begin() + b.qpos_adr;
-    if (b.joint == JointType::ball) {
-      const Quat r = quat_exp(Vec3(n(rng), n(rng), n(rng)));
-      q[0] = r.w();
-      q[1] = r.x();
-      q[2] = r.y();
-      q[3] = r.z();
-    } else if (b.joint == JointType::hinge) {
-      q[0] = std::abs(n(rng));
-    }
-  }
-}
+void random_pose(const Model& m, Data& d, unsigned seed) { test::random_joint_pose(m, d.qpos, seed, 0.3); }
 
 struct Comparison {
   double at_100ms = 0.0;

@@ -1,7 +1,7 @@
 // Bad input gives no points (never NaN, never a crash), output limits are
 // honoured, results scale with the scene, and collide() allocates nothing:
-// operator new is replaced here and the malloc family wrapped at link time
-// (see CMakeLists.txt), both counted while collide() runs.
+// operator new and the malloc family are counted while collide() runs
+// (tests/support/allocation_counter).
 #include <doctest/doctest.h>
 
 #include <array>
@@ -12,64 +12,11 @@
 #include <new>
 
 #include "reference.hpp"
+#include "support/allocation_counter.hpp"
 #include "tonus/sim/collision.hpp"
 
 using namespace tonus::sim;
 using namespace tonus::sim::test;
-
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0};
-void count() {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-}
-}  // namespace
-
-// The linker's --wrap names are reserved identifiers by necessity.
-// NOLINTBEGIN(bugprone-reserved-identifier)
-extern "C" {
-void* __real_malloc(std::size_t n);
-void* __real_calloc(std::size_t n, std::size_t s);
-void* __real_realloc(void* p, std::size_t n);
-int __real_posix_memalign(void** p, std::size_t a, std::size_t n);
-void* __real_aligned_alloc(std::size_t a, std::size_t n);
-void* __wrap_malloc(std::size_t n) {
-  count();
-  return __real_malloc(n);
-}
-void* __wrap_calloc(std::size_t n, std::size_t s) {
-  count();
-  return __real_calloc(n, s);
-}
-void* __wrap_realloc(void* p, std::size_t n) {
-  count();
-  return __real_realloc(p, n);
-}
-int __wrap_posix_memalign(void** p, std::size_t a, std::size_t n) {
-  count();
-  return __real_posix_memalign(p, a, n);
-}
-void* __wrap_aligned_alloc(std::size_t a, std::size_t n) {
-  count();
-  return __real_aligned_alloc(a, n);
-}
-}
-// NOLINTEND(bugprone-reserved-identifier)
-
-void* operator new(std::size_t n) {
-  count();
-  if (void* p = __real_malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) {
-  count();
-  if (void* p = __real_malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace {
 
@@ -241,27 +188,19 @@ TEST_CASE("collision: collide allocates nothing") {
   std::array<ContactPoint, 4> out{};
   std::size_t points = 0;
   // Prove the counter counts before trusting a zero.
-  g_allocations = 0;
-  g_counting = true;
-  // volatile: the compiler may otherwise elide an unused allocation.
-  void* volatile probe = std::malloc(16);
-  void* volatile object = ::operator new(16);
-  g_counting = false;
-  std::free(probe);
-  ::operator delete(object);
-  REQUIRE(g_allocations.load() == 2);
+  REQUIRE(tonus::test::probe_allocation_counter() == 2);
 
-  g_allocations = 0;
+  long allocations = 0;
   for (const ShapeType ta : kTypes) {
     for (const ShapeType tb : kTypes) {
       for (int i = 0; i < 500; ++i) {
         const Config c = random_config(ta, tb, rng);
-        g_counting = true;
+        tonus::test::start_counting_allocations();
         points += collide(c.a, c.pa, c.b, c.pb, c.margin, out);
-        g_counting = false;
+        allocations += tonus::test::stop_counting_allocations();
       }
     }
   }
   CHECK(points > 1000);
-  CHECK(g_allocations.load() == 0);
+  CHECK(allocations == 0);
 }
