@@ -1,0 +1,29 @@
+// Writes the balance filter's waist corrections back into a BVH clip: the
+// hips joint's rotation and position channels (the waist turns about the
+// midpoint of the hip joints), and the thigh, shank and foot rotations that
+// keep each foot where it was. Each joint keeps its own channel order and its
+// angles stay continuous. The result is measured, not assumed: the feet's
+// displacement and the joint-angle change come from forward kinematics of the
+// written clip against the original.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "tonus/host/balance/convert.hpp"
+
+namespace tonus::balance {
+
+struct AppliedCorrection {
+  motion::Clip clip;
+  double max_foot_displacement_m = 0.0;  // ankles, toe joints and toe tips, over every frame
+  double rms_joint_change_rad = 0.0;     // local rotations of every mapped joint, over analysed frames
+  std::string error;
+  [[nodiscard]] bool ok() const { return error.empty(); }
+};
+
+// `correction` has one rotation vector per frame (internal frame, radians).
+AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeometry& geometry,
+                                   const std::vector<Vec3>& correction, std::size_t first_frame);
+
+}  // namespace tonus::balance

@@ -1,0 +1,62 @@
+// Which foot touches the ground when, and the support polygon it spans.
+//
+// Each foot has two contact points, the heel and the ball (the toe joint),
+// each in contact while it is low and slow, with hysteresis (it enters below
+// the `on` thresholds and leaves above the `off` ones) so a foot does not
+// flicker. The sole is a polygon fixed to the foot, measured once from the
+// frame where the foot stands flat; in contact, the part of the sole under the
+// touching points supports: the whole sole, the forefoot (heel off) or the
+// rear foot (heel strike). The support polygon is the convex hull of the
+// supporting parts of both feet; a frame with neither foot down is airborne.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "tonus/host/balance/landmarks.hpp"
+#include "tonus/host/balance/polygon.hpp"
+
+namespace tonus::balance {
+
+struct ContactOptions {
+  double height_on_m = 0.025;  // above the point's own resting height
+  double height_off_m = 0.040;
+  double speed_on_mps = 0.30;
+  double speed_off_mps = 0.60;
+  std::optional<double> foot_length_m;  // sole length; default: from the skeleton's proportions
+  std::optional<double> ground_z_m;     // default: estimated from the lowest foot points
+};
+
+// The sole in the foot's frame (the Foot bone's rotation), and the toes' part
+// in the Toes bone's frame, relative to their joints.
+struct Sole {
+  std::vector<Vec3> rear;  // heel corners
+  std::vector<Vec3> ball;  // corners under the toe joint (in the foot frame)
+  std::vector<Vec3> toes;  // toe-tip corners (in the toes frame; relative to the toe joint)
+  double length_m = 0.0;
+  double width_m = 0.0;
+};
+
+struct FootContact {
+  bool heel = false;
+  bool ball = false;
+  [[nodiscard]] bool any() const { return heel || ball; }
+};
+
+struct ContactTrack {
+  double ground_z_m = 0.0;
+  std::array<Sole, 2> soles;
+  std::vector<std::array<FootContact, 2>> frames;  // [frame][foot]
+};
+
+// Detects contacts over a whole motion (offline: thresholds use each point's
+// resting height over the clip).
+ContactTrack detect_contacts(const HumanMotion& motion, const ContactOptions& options);
+
+// The support polygon of a frame (empty when airborne), in the ground plane.
+ConvexPolygon support_polygon(const ContactTrack& track, const MotionFrame& frame, std::size_t index);
+
+// The world sole outline of one foot at a frame (all three parts), for plots.
+std::vector<Vec2> sole_outline(const ContactTrack& track, const MotionFrame& frame, Foot foot);
+
+}  // namespace tonus::balance

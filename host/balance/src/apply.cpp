@@ -1,0 +1,147 @@
+#include "tonus/host/balance/apply.hpp"
+
+#include <cmath>
+
+namespace tonus::balance {
+namespace {
+
+using sim::Bone;
+using Vec3d = Eigen::Vector3d;
+using Quatd = Eigen::Quaterniond;
+
+Quatd exp_map(const Vec3& v) {
+  const double a = v.norm();
+  return a < 1e-12 ? Quatd::Identity() : Quatd(Eigen::AngleAxisd(a, v / a));
+}
+
+// A joint's new local rotation from its parent's new global one and its own new global one.
+Quatd local_from(const std::vector<motion::JointPose>& poses, const std::vector<Quatd>& global,
+                 const motion::Clip& clip, std::size_t joint) {
+  const int p = clip.joints[joint].parent;
+  const Quatd parent = p >= 0 ? global[static_cast<std::size_t>(p)] : Quatd::Identity();
+  (void)poses;
+  return (parent.conjugate() * global[joint]).normalized();
+}
+
+}  // namespace
+
+AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeometry& g,
+                                   const std::vector<Vec3>& correction, std::size_t first_frame) {
+  AppliedCorrection out;
+  out.clip = clip;
+  const auto bone = [&](Bone b) { return g.map.joint[sim::index(b)]; };
+  const int hips = bone(Bone::Hips);
+  const motion::Joint& hj = clip.joints[static_cast<std::size_t>(hips)];
+  int position_channels = 0;
+  for (const motion::Channel c : hj.channels) position_channels += motion::is_rotation(c) ? 0 : 1;
+  if (position_channels != 3) {
+    out.error = "the hips joint '" + hj.name + "' has no position channels: the waist cannot turn about the hip joints";
+    return out;
+  }
+  if (correction.size() != clip.frame_count) {
+    out.error = "one correction per frame is needed";
+    return out;
+  }
+  const Quatd to_int = file_to_internal();
+  std::vector<motion::JointPose> poses;
+  std::vector<Quatd> global;
+  double sum_sq = 0.0;
+  std::size_t samples = 0;
+  for (std::size_t f = 0; f < clip.frame_count; ++f) {
+    if (!motion::forward_kinematics(clip, f, poses)) {
+      out.error = "forward kinematics failed at frame " + std::to_string(f);
+      return out;
+    }
+    if (correction[f].norm() == 0.0) continue;
+    const Quatd r = to_int.conjugate() * exp_map(correction[f]) * to_int;  // the turn in the file's frame
+    const auto p = [&](Bone b) { return poses[static_cast<std::size_t>(bone(b))].position; };
+    const Vec3d pivot = 0.5 * (p(Bone::LeftUpperLeg) + p(Bone::RightUpperLeg));
+    global.resize(poses.size());
+    for (std::size_t j = 0; j < poses.size(); ++j) global[j] = poses[j].rotation;
+    // The hips and everything on the pelvis turn rigidly: new hips rotation and position.
+    const auto hu = static_cast<std::size_t>(hips);
+    global[hu] = r * poses[hu].rotation;
+    const Vec3d hips_pos = pivot + r * (poses[hu].position - pivot);
+    const int hp = clip.joints[hu].parent;
+    const Quatd parent_rot = hp >= 0 ? poses[static_cast<std::size_t>(hp)].rotation : Quatd::Identity();
+    const Vec3d parent_pos = hp >= 0 ? poses[static_cast<std::size_t>(hp)].position : Vec3d::Zero();
+    motion::set_local_rotation(out.clip, f, hu, local_from(poses, global, clip, hu));
+    motion::set_local_translation(out.clip, f, hu, parent_rot.conjugate() * (hips_pos - parent_pos));
+    // Below the hips every joint keeps its local rotation (its global turns
+    // with the hips), except the thighs, shanks and feet the IK sets; walk the
+    // hierarchy in file order so every parent's new rotation is known first.
+    std::vector<int> desired(poses.size(), -1);  // index into wanted[]
+    std::vector<Quatd> wanted;
+    for (const bool left : {true, false}) {
+      const int thigh = bone(left ? Bone::LeftUpperLeg : Bone::RightUpperLeg);
+      const int shank = bone(left ? Bone::LeftLowerLeg : Bone::RightLowerLeg);
+      const int foot = bone(left ? Bone::LeftFoot : Bone::RightFoot);
+      const auto tu = static_cast<std::size_t>(thigh), su = static_cast<std::size_t>(shank),
+                 fu = static_cast<std::size_t>(foot);
+      const Vec3d hip = poses[tu].position, knee = poses[su].position, ankle = poses[fu].position;
+      const Vec3d hip2 = pivot + r * (hip - pivot);
+      const double l1 = (knee - hip).norm(), l2 = (ankle - knee).norm();
+      const Vec3d d = ankle - hip2;
+      double dist = d.norm();
+      if (dist < 1e-12) continue;
+      const Vec3d u = d / dist;
+      dist = std::min(dist, l1 + l2);
+      const double a = (l1 * l1 - l2 * l2 + dist * dist) / (2.0 * dist);
+      const double h = std::sqrt(std::max(l1 * l1 - a * a, 0.0));
+      Vec3d v = (knee - hip2) - (knee - hip2).dot(u) * u;
+      if (v.norm() < 1e-12) v = u.unitOrthogonal();
+      v.normalize();
+      const Vec3d knee2 = hip2 + a * u + h * v;
+      desired[tu] = static_cast<int>(wanted.size());
+      wanted.push_back(Quatd::FromTwoVectors(knee - hip, knee2 - hip2) * poses[tu].rotation);
+      desired[su] = static_cast<int>(wanted.size());
+      wanted.push_back(Quatd::FromTwoVectors(ankle - knee, ankle - knee2) * poses[su].rotation);
+      desired[fu] = static_cast<int>(wanted.size());
+      wanted.push_back(poses[fu].rotation);  // the foot keeps its world orientation
+    }
+    std::vector<bool> below(poses.size(), false);
+    below[hu] = true;
+    for (std::size_t j = hu + 1; j < poses.size(); ++j) {
+      const int par = clip.joints[j].parent;
+      if (par < 0 || !below[static_cast<std::size_t>(par)]) continue;
+      below[j] = true;
+      if (desired[j] >= 0) {
+        global[j] = wanted[static_cast<std::size_t>(desired[j])];
+        motion::set_local_rotation(out.clip, f, j, local_from(poses, global, clip, j));
+      } else {
+        global[j] = global[static_cast<std::size_t>(par)] * poses[j].local_rotation;
+      }
+    }
+  }
+  // Measure what was written.
+  std::vector<motion::JointPose> before, after;
+  for (std::size_t f = 0; f < clip.frame_count; ++f) {
+    motion::forward_kinematics(clip, f, before);
+    motion::forward_kinematics(out.clip, f, after);
+    for (const Bone b : {Bone::LeftFoot, Bone::RightFoot, Bone::LeftToes, Bone::RightToes}) {
+      const int j = bone(b);
+      if (j < 0) continue;
+      const auto ju = static_cast<std::size_t>(j);
+      out.max_foot_displacement_m =
+          std::max(out.max_foot_displacement_m, g.metres_per_unit * (after[ju].position - before[ju].position).norm());
+    }
+    for (const int tip : g.toe_tip_joint) {
+      if (tip < 0) continue;
+      const auto ju = static_cast<std::size_t>(tip);
+      out.max_foot_displacement_m =
+          std::max(out.max_foot_displacement_m, g.metres_per_unit * (after[ju].position - before[ju].position).norm());
+    }
+    if (f < first_frame) continue;
+    for (const int j : g.map.joint) {
+      if (j < 0) continue;
+      const auto ju = static_cast<std::size_t>(j);
+      const double angle = before[ju].local_rotation.angularDistance(after[ju].local_rotation);
+      sum_sq += angle * angle;
+      ++samples;
+    }
+  }
+  out.rms_joint_change_rad = samples > 0 ? std::sqrt(sum_sq / static_cast<double>(samples)) : 0.0;
+  return out;
+}
+
+}  // namespace tonus::balance

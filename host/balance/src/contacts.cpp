@@ -1,0 +1,206 @@
+// Foot contacts, soles and support polygons. The proportions (heel 23 % of the
+// foot length behind the ankle, the ball 56 % and the toe tip 77 % in front of
+// it, breadth 38 % of the length) are Winter's (2009) foot geometry, the one
+// the physics humanoid uses too; see docs/balance.md.
+#include "tonus/host/balance/contacts.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace tonus::balance {
+namespace {
+
+constexpr double kHeelBehindAnkle = 0.23;   // of the foot length
+constexpr double kBallAheadOfAnkle = 0.56;  // of the foot length
+constexpr double kTipAheadOfAnkle = 0.77;
+constexpr double kBreadth = 0.38;
+constexpr double kSoleBelowLowestPoint = 0.02;  // tracked foot points sit ~2 cm above the sole
+constexpr double kRearFootShare = 0.25;         // heel-only contact: the rear quarter of the sole supports
+
+Vec2 horizontal(const Vec3& v) { return {v.x(), v.y()}; }
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+// The frame where the foot stands flattest: ankle and ball low and slow.
+std::size_t flat_frame(const HumanMotion& m, const FootLandmarks& f) {
+  std::size_t best = m.first_frame;
+  double best_score = std::numeric_limits<double>::infinity();
+  for (std::size_t t = std::max<std::size_t>(m.first_frame, 1); t + 1 < m.size(); ++t) {
+    const auto& a = m.frames[t].p;
+    const double speed = ((m.frames[t + 1].p[index(f.ankle)] - m.frames[t - 1].p[index(f.ankle)]).norm() +
+                          (m.frames[t + 1].p[index(f.toe_joint)] - m.frames[t - 1].p[index(f.toe_joint)]).norm()) /
+                         (2.0 * m.dt_s);
+    const double score = a[index(f.ankle)].z() + a[index(f.toe_joint)].z() + 0.05 * speed;
+    if (score < best_score) {
+      best_score = score;
+      best = t;
+    }
+  }
+  return best;
+}
+
+Sole measure_sole(const HumanMotion& m, Foot foot, double ground_z, const ContactOptions& opt) {
+  const FootLandmarks f = foot_landmarks(foot);
+  const std::size_t t0 = flat_frame(m, f);
+  const MotionFrame& fr = m.frames[t0];
+  const Vec3 ankle = fr.p[index(f.ankle)], ball = fr.p[index(f.toe_joint)], tip = fr.p[index(f.toe_tip)];
+  Vec2 fwd = horizontal(ball - ankle);
+  if (fwd.norm() < 1e-6) fwd = Vec2(1, 0);
+  const double ball_ahead = fwd.norm();
+  fwd.normalize();
+  const Vec2 side(-fwd.y(), fwd.x());
+  const double tip_ahead = horizontal(tip - ankle).dot(fwd);
+  double length = ball_ahead / kBallAheadOfAnkle;
+  if (tip_ahead > ball_ahead + 0.01) length = tip_ahead / kTipAheadOfAnkle;  // a real toe tip: trust it
+  if (opt.foot_length_m) length = *opt.foot_length_m;
+  Sole s;
+  s.length_m = length;
+  s.width_m = kBreadth * length;
+  const auto on_ground = [&](const Vec2& p) { return Vec3(p.x(), p.y(), ground_z); };
+  const Vec2 a2 = horizontal(ankle);
+  const Vec2 heel = a2 - kHeelBehindAnkle * length * fwd;
+  const Vec2 ball2 = a2 + kBallAheadOfAnkle * length * fwd;
+  const Vec2 tip2 = a2 + kTipAheadOfAnkle * length * fwd;
+  const Quat foot_rot = fr.rotation[sim::index(foot == Foot::left ? sim::Bone::LeftFoot : sim::Bone::RightFoot)];
+  const Quat toes_rot = fr.rotation[sim::index(foot == Foot::left ? sim::Bone::LeftToes : sim::Bone::RightToes)];
+  const auto in_foot = [&](const Vec2& p) { return Vec3(foot_rot.conjugate() * (on_ground(p) - ankle)); };
+  const auto in_toes = [&](const Vec2& p) { return Vec3(toes_rot.conjugate() * (on_ground(p) - ball)); };
+  const double w = s.width_m;
+  s.rear = {in_foot(heel + 0.4 * w * side), in_foot(heel - 0.4 * w * side)};
+  s.ball = {in_foot(ball2 + 0.5 * w * side), in_foot(ball2 - 0.5 * w * side)};
+  s.toes = {in_toes(tip2 + 0.3 * w * side), in_toes(tip2 - 0.3 * w * side)};
+  return s;
+}
+
+struct SoleWorld {
+  std::vector<Vec3> rear, ball, toes;
+};
+
+SoleWorld place(const Sole& s, const MotionFrame& fr, Foot foot) {
+  const FootLandmarks f = foot_landmarks(foot);
+  const Quat foot_rot = fr.rotation[sim::index(foot == Foot::left ? sim::Bone::LeftFoot : sim::Bone::RightFoot)];
+  const Quat toes_rot = fr.rotation[sim::index(foot == Foot::left ? sim::Bone::LeftToes : sim::Bone::RightToes)];
+  const Vec3 ankle = fr.p[index(f.ankle)], ball = fr.p[index(f.toe_joint)];
+  SoleWorld w;
+  for (const Vec3& p : s.rear) w.rear.emplace_back(ankle + foot_rot * p);
+  for (const Vec3& p : s.ball) w.ball.emplace_back(ankle + foot_rot * p);
+  for (const Vec3& p : s.toes) w.toes.emplace_back(ball + toes_rot * p);
+  return w;
+}
+
+Vec3 mean(const std::vector<Vec3>& v) {
+  Vec3 c = Vec3::Zero();
+  for (const Vec3& p : v) c += p;
+  return v.empty() ? c : Vec3(c / static_cast<double>(v.size()));
+}
+
+// Low-and-slow with hysteresis over a series of heights and speeds.
+std::vector<bool> hysteresis(const std::vector<double>& height, const std::vector<double>& speed, double rest,
+                             const ContactOptions& o) {
+  std::vector<bool> on(height.size(), false);
+  bool state = false;
+  for (std::size_t t = 0; t < height.size(); ++t) {
+    const double h = height[t] - rest;
+    if (state) {
+      state = !(h > o.height_off_m || speed[t] > o.speed_off_mps);
+    } else {
+      state = h < o.height_on_m && speed[t] < o.speed_on_mps;
+    }
+    on[t] = state;
+  }
+  return on;
+}
+
+}  // namespace
+
+ContactTrack detect_contacts(const HumanMotion& m, const ContactOptions& opt) {
+  ContactTrack track;
+  track.frames.assign(m.size(), {});
+  if (m.size() < 3) return track;
+  // Ground: just below the lowest tracked foot points when they rest.
+  if (opt.ground_z_m) {
+    track.ground_z_m = *opt.ground_z_m;
+  } else {
+    std::vector<double> lows;
+    for (std::size_t t = m.first_frame; t < m.size(); ++t) {
+      double low = std::numeric_limits<double>::infinity();
+      for (const Foot foot : {Foot::left, Foot::right}) {
+        const FootLandmarks f = foot_landmarks(foot);
+        for (const Landmark l : {f.ankle, f.toe_joint, f.toe_tip}) low = std::min(low, m.frames[t].p[index(l)].z());
+      }
+      lows.push_back(low);
+    }
+    track.ground_z_m = percentile(lows, 0.05) - kSoleBelowLowestPoint;
+  }
+  for (const Foot foot : {Foot::left, Foot::right}) {
+    const auto fi = static_cast<std::size_t>(foot);
+    track.soles[fi] = measure_sole(m, foot, track.ground_z_m, opt);
+    // Heights and speeds of the heel and the ball over the clip.
+    std::vector<Vec3> heel(m.size()), ball(m.size());
+    for (std::size_t t = 0; t < m.size(); ++t) {
+      const SoleWorld w = place(track.soles[fi], m.frames[t], foot);
+      heel[t] = mean(w.rear);
+      ball[t] = mean(w.ball);
+    }
+    const auto speeds = [&](const std::vector<Vec3>& p) {
+      std::vector<double> v(p.size(), 0.0);
+      for (std::size_t t = 1; t + 1 < p.size(); ++t) v[t] = (p[t + 1] - p[t - 1]).norm() / (2.0 * m.dt_s);
+      v.front() = v[1];
+      v.back() = v[v.size() - 2];
+      return v;
+    };
+    const auto heights = [&](const std::vector<Vec3>& p) {
+      std::vector<double> h(p.size());
+      for (std::size_t t = 0; t < p.size(); ++t) h[t] = p[t].z();
+      return h;
+    };
+    const std::vector<double> hh = heights(heel), hb = heights(ball);
+    std::vector<double> rest_h(hh.begin() + static_cast<std::ptrdiff_t>(m.first_frame), hh.end());
+    std::vector<double> rest_b(hb.begin() + static_cast<std::ptrdiff_t>(m.first_frame), hb.end());
+    const std::vector<bool> heel_on = hysteresis(hh, speeds(heel), percentile(rest_h, 0.05), opt);
+    const std::vector<bool> ball_on = hysteresis(hb, speeds(ball), percentile(rest_b, 0.05), opt);
+    for (std::size_t t = 0; t < m.size(); ++t) track.frames[t][fi] = {heel_on[t], ball_on[t]};
+  }
+  return track;
+}
+
+ConvexPolygon support_polygon(const ContactTrack& track, const MotionFrame& frame, std::size_t t) {
+  std::vector<Vec2> pts;
+  for (const Foot foot : {Foot::left, Foot::right}) {
+    const auto fi = static_cast<std::size_t>(foot);
+    const FootContact c = track.frames[t][fi];
+    if (!c.any()) continue;
+    const SoleWorld w = place(track.soles[fi], frame, foot);
+    if (c.ball) {
+      for (const Vec3& p : w.ball) pts.push_back(horizontal(p));
+      for (const Vec3& p : w.toes) pts.push_back(horizontal(p));
+    }
+    if (c.heel) {
+      for (const Vec3& p : w.rear) pts.push_back(horizontal(p));
+      if (!c.ball) {  // heel strike: the rear of the sole
+        for (std::size_t k = 0; k < w.rear.size() && k < w.ball.size(); ++k) {
+          const double share = kRearFootShare / (kHeelBehindAnkle + kBallAheadOfAnkle);
+          pts.push_back(horizontal(w.rear[k] + share * (w.ball[k] - w.rear[k])));
+        }
+      }
+    }
+  }
+  return convex_hull(pts);
+}
+
+std::vector<Vec2> sole_outline(const ContactTrack& track, const MotionFrame& frame, Foot foot) {
+  const SoleWorld w = place(track.soles[static_cast<std::size_t>(foot)], frame, foot);
+  std::vector<Vec2> pts;
+  for (const auto* part : {&w.rear, &w.ball, &w.toes}) {
+    for (const Vec3& p : *part) pts.push_back(horizontal(p));
+  }
+  return convex_hull(pts).vertices;
+}
+
+}  // namespace tonus::balance

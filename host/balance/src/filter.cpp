@@ -1,0 +1,325 @@
+// Gauss-Newton over the waist corrections of all frames (see filter.hpp).
+#include "tonus/host/balance/filter.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <cmath>
+
+#include "tonus/host/balance/zmp.hpp"
+#include "tonus/host/derivatives/batch.hpp"
+
+namespace tonus::balance {
+namespace {
+
+// ZMP-equivalent scales: what one radian of correction, or one rad/s^2 of its
+// angular acceleration, moves the ZMP by, roughly, for an adult (the upper
+// body's mass share times its lever, and that times its height over g).
+constexpr double kSizeScale_m = 0.2;
+constexpr double kAccelScale_m = 0.02;
+// Metres of ZMP error that one metre of leg over-reach weighs like.
+constexpr double kReachWeight = 30.0;
+
+struct Targets {
+  std::vector<bool> active;
+  std::vector<Vec2> target;
+};
+
+HumanMotion corrected_motion(const HumanMotion& m, const std::vector<Vec3>& delta, std::vector<bool>& unreachable) {
+  HumanMotion out = m;  // (frames before first_frame stay as they are)
+  unreachable.assign(m.size(), false);
+  for (std::size_t t = m.first_frame; t < m.size(); ++t) {
+    bool ok = true;
+    out.frames[t] = rotate_waist(m.frames[t], delta[t], ok);
+    unreachable[t] = !ok;
+  }
+  return out;
+}
+
+Targets choose_targets(const Analysis& a, double margin) {
+  Targets t;
+  t.active.assign(a.frames.size(), false);
+  t.target.assign(a.frames.size(), Vec2::Zero());
+  for (std::size_t k = 0; k < a.frames.size(); ++k) {
+    const FrameAnalysis& f = a.frames[k];
+    if (!f.analysed || f.airborne || !f.zmp_defined) continue;
+    if (f.outside_m <= -margin) continue;  // comfortably inside: no term
+    t.active[k] = true;
+    t.target[k] = nearest_point_inset(f.support, f.zmp, margin);
+  }
+  return t;
+}
+
+double objective(const Analysis& a, const Targets& t, const std::vector<Vec3>& delta, std::size_t first, double dt,
+                 const FilterOptions& o, const std::vector<double>& weight) {
+  double cost = 0.0;
+  for (std::size_t k = first; k < a.frames.size(); ++k) {
+    if (t.active[k]) cost += weight[k] * (a.frames[k].zmp - t.target[k]).squaredNorm();
+    cost += std::pow(o.size_weight * kSizeScale_m, 2) * delta[k].squaredNorm();
+    if (k > first && k + 1 < a.frames.size()) {
+      const Vec3 acc = (delta[k - 1] - 2.0 * delta[k] + delta[k + 1]) / (dt * dt);
+      cost += std::pow(o.smoothness * kAccelScale_m, 2) * acc.squaredNorm();
+    }
+  }
+  return cost;
+}
+
+// The analysis' acceleration operator: smoothing and differentiation are
+// linear in the samples (no outlier gate), so a(x + dx) = a(x) + D dx; column j
+// of D is the acceleration of a unit impulse at j. Kept as a band around the
+// diagonal, as wide as an interior column's significant entries.
+struct AccelOperator {
+  std::size_t band = 0;
+  std::size_t n = 0;
+  std::vector<double> coef;  // coef[j * (2 band + 1) + (k + band - j)] = D[k][j]
+  [[nodiscard]] double at(std::size_t k, std::size_t j) const {
+    if (k + band < j || k > j + band) return 0.0;
+    return coef[j * (2 * band + 1) + (k + band - j)];
+  }
+};
+
+AccelOperator accel_operator(std::size_t n, double dt, const derivatives::Params& params) {
+  AccelOperator op;
+  op.n = n;
+  std::vector<double> impulse(n, 0.0);
+  const std::size_t mid = n / 2;
+  impulse[mid] = 1.0;
+  const derivatives::Result probe = derivatives::differentiate(impulse, dt, params);
+  double peak = 0.0;
+  for (const double v : probe.acc) peak = std::max(peak, std::abs(v));
+  for (std::size_t k = 0; k < n; ++k) {
+    if (std::abs(probe.acc[k]) > 1e-7 * peak) op.band = std::max(op.band, k > mid ? k - mid : mid - k);
+  }
+  op.band = std::min(op.band, n - 1);
+  const std::size_t w = 2 * op.band + 1;
+  op.coef.assign(n * w, 0.0);
+  for (std::size_t j = 0; j < n; ++j) {
+    impulse.assign(n, 0.0);
+    impulse[j] = 1.0;
+    const derivatives::Result col = derivatives::differentiate(impulse, dt, params);
+    for (std::size_t k = (j > op.band ? j - op.band : 0); k < std::min(n, j + op.band + 1); ++k) {
+      op.coef[j * w + (k + op.band - j)] = col.acc[k];
+    }
+  }
+  return op;
+}
+
+// d zmp / d (segment position) and d zmp / d (segment acceleration), 2 x 3 each,
+// from p = M / N (zmp.hpp), at one frame.
+struct ZmpPartials {
+  std::array<Eigen::Matrix<double, 2, 3>, kSegmentParts> dpos;
+  std::array<Eigen::Matrix<double, 2, 3>, kSegmentParts> dacc;
+};
+
+ZmpPartials zmp_partials(const MassModel& model, const SegmentFrame& seg, const std::array<Vec3, kSegmentParts>& acc,
+                         const Vec2& p, double ground_z, double g) {
+  ZmpPartials d;
+  double n = 0.0;
+  for (std::size_t i = 0; i < kSegmentParts; ++i) n += model.parts[i].mass_kg * (acc[i].z() + g);
+  for (std::size_t i = 0; i < kSegmentParts; ++i) {
+    const double m = model.parts[i].mass_kg / n;
+    const Vec3& c = seg[i].com;
+    const Vec3& a = acc[i];
+    d.dpos[i] << m * (a.z() + g), 0.0, -m * a.x(), 0.0, m * (a.z() + g), -m * a.y();
+    d.dacc[i] << -m * (c.z() - ground_z), 0.0, m * (c.x() - p.x()), 0.0, -m * (c.z() - ground_z), m * (c.y() - p.y());
+  }
+  return d;
+}
+
+std::size_t count_outside(const Analysis& a, double tol) {
+  std::size_t n = 0;
+  for (const FrameAnalysis& f : a.frames) n += f.analysed && !f.airborne && f.zmp_defined && f.outside_m > tol ? 1 : 0;
+  return n;
+}
+
+}  // namespace
+
+FilterResult balance_filter(const HumanMotion& motion, const FilterOptions& o, FilterProgress progress, void* user) {
+  FilterResult r;
+  const std::size_t n = motion.size(), first = motion.first_frame;
+  const double dt = motion.dt_s;
+  r.before = analyse(motion, o.analysis);
+  if (!r.before.ok()) {
+    r.error = r.before.error;
+    return r;
+  }
+  const ContactTrack& contacts = r.before.contacts;  // the feet do not move: neither do their contacts
+  r.correction.assign(n, Vec3::Zero());
+  std::vector<bool> unreachable;
+  Analysis now = r.before;
+  const double tol = o.analysis.tolerance_m;
+  const std::size_t m = n - first;
+  const AccelOperator op = accel_operator(m, dt, o.analysis.derivatives);
+  std::vector<double> weight(n, 1.0);  // grows for frames that stay outside (penalty continuation)
+  double damping = 1e-6;               // Levenberg-Marquardt
+
+  for (r.iterations = 0; r.iterations < o.max_iterations; ++r.iterations) {
+    const std::size_t outside = count_outside(now, tol);
+    if (progress != nullptr) progress(r.iterations, outside, user);
+    if (outside == 0) break;
+    const Targets targets = choose_targets(now, o.margin_m);
+    for (std::size_t k = first; k < n; ++k) {
+      const FrameAnalysis& f = now.frames[k];
+      if (targets.active[k] && f.outside_m > tol) weight[k] = std::min(weight[k] * 2.0, 1e4);
+    }
+
+    // Derivatives of every frame's segment positions and leg over-reach with
+    // respect to its own correction (numerically: the IK is cheap).
+    using Triplet = Eigen::Triplet<double>;
+    std::vector<Triplet> jac;
+    std::vector<double> residual;
+    std::size_t row = 0;
+    const double h = 1e-6;
+    std::vector<std::array<Vec3, kSegmentParts>> dcom(3 * m);
+    std::vector<std::array<double, 2>> reach(m), dreach(3 * m);
+    for (std::size_t k = first; k < n; ++k) {
+      const SegmentFrame& base = now.segments[k];
+      bool ok = true;
+      rotate_waist(motion.frames[k], r.correction[k], ok, reach[k - first].data());
+      for (int e = 0; e < 3; ++e) {
+        Vec3 d = r.correction[k];
+        d(e) += h;
+        std::array<double, 2> moved_reach{};
+        const SegmentFrame moved =
+            place_segments(now.mass, rotate_waist(motion.frames[k], d, ok, moved_reach.data()).p);
+        const std::size_t idx = 3 * (k - first) + static_cast<std::size_t>(e);
+        for (std::size_t i = 0; i < kSegmentParts; ++i) dcom[idx][i] = (moved[i].com - base[i].com) / h;
+        for (std::size_t leg = 0; leg < 2; ++leg) dreach[idx][leg] = (moved_reach[leg] - reach[k - first][leg]) / h;
+      }
+    }
+    // ZMP residuals: a frame's ZMP moves with its own correction (its
+    // segments) and with every correction within the operator's band (its accelerations).
+    for (std::size_t k = first; k < n; ++k) {
+      if (!targets.active[k]) continue;
+      const double sw = std::sqrt(weight[k]);
+      const Vec2 res = sw * (now.frames[k].zmp - targets.target[k]);
+      for (int c = 0; c < 2; ++c) residual.push_back(res(c));
+      const ZmpPartials dp = zmp_partials(now.mass, now.segments[k], now.accelerations[k], now.frames[k].zmp,
+                                          contacts.ground_z_m, o.analysis.gravity);
+      const std::size_t kk = k - first;
+      const std::size_t lo = kk > op.band ? kk - op.band : 0, hi = std::min(m - 1, kk + op.band);
+      for (std::size_t jj = lo; jj <= hi; ++jj) {
+        const double w = op.at(kk, jj);
+        for (int e = 0; e < 3; ++e) {
+          const auto& dc = dcom[3 * jj + static_cast<std::size_t>(e)];
+          Vec2 dz = Vec2::Zero();
+          for (std::size_t i = 0; i < kSegmentParts; ++i) {
+            dz += w * (dp.dacc[i] * dc[i]);
+            if (jj == kk) dz += dp.dpos[i] * dc[i];
+          }
+          const auto col = static_cast<int>(3 * jj + static_cast<std::size_t>(e));
+          for (int c = 0; c < 2; ++c) jac.emplace_back(static_cast<int>(row) + c, col, sw * dz(c));
+        }
+      }
+      row += 2;
+    }
+    // Leg over-reach residuals (one-sided): keep every leg able to reach its foot.
+    for (std::size_t kk = 0; kk < m; ++kk) {
+      for (std::size_t leg = 0; leg < 2; ++leg) {
+        if (reach[kk][leg] <= 0.0) continue;
+        residual.push_back(kReachWeight * reach[kk][leg]);
+        for (int e = 0; e < 3; ++e) {
+          jac.emplace_back(static_cast<int>(row), static_cast<int>(3 * kk + static_cast<std::size_t>(e)),
+                           kReachWeight * dreach[3 * kk + static_cast<std::size_t>(e)][leg]);
+        }
+        ++row;
+      }
+    }
+
+    // Normal equations: J^T J + smoothness (second difference) + size + damping.
+    const auto unknowns = static_cast<Eigen::Index>(3 * m);
+    Eigen::SparseMatrix<double> j_mat(static_cast<Eigen::Index>(row), unknowns);
+    j_mat.setFromTriplets(jac.begin(), jac.end());
+    Eigen::SparseMatrix<double> hess = j_mat.transpose() * j_mat;
+    Eigen::VectorXd rhs =
+        -(j_mat.transpose() * Eigen::Map<const Eigen::VectorXd>(residual.data(), static_cast<Eigen::Index>(row)));
+    std::vector<Triplet> reg;
+    const double ws = std::pow(o.smoothness * kAccelScale_m / (dt * dt), 2);
+    const double wr = std::pow(o.size_weight * kSizeScale_m, 2);
+    for (std::size_t k = 0; k < m; ++k) {
+      for (int e = 0; e < 3; ++e) {
+        const auto i = static_cast<int>(3 * k + static_cast<std::size_t>(e));
+        reg.emplace_back(i, i, wr);
+        rhs(i) -= wr * r.correction[first + k](e);
+      }
+    }
+    for (std::size_t k = 1; k + 1 < m; ++k) {  // second difference over (k-1, k, k+1)
+      const double coef[3] = {1.0, -2.0, 1.0};
+      for (int e = 0; e < 3; ++e) {
+        double d2 = 0.0;
+        for (std::size_t a = 0; a < 3; ++a) d2 += coef[a] * r.correction[first + k - 1 + a](e);
+        for (std::size_t a = 0; a < 3; ++a) {
+          const auto ia = static_cast<int>(3 * (k - 1 + a) + static_cast<std::size_t>(e));
+          rhs(ia) -= ws * coef[a] * d2;
+          for (std::size_t b = 0; b < 3; ++b) {
+            reg.emplace_back(ia, static_cast<int>(3 * (k - 1 + b) + static_cast<std::size_t>(e)),
+                             ws * coef[a] * coef[b]);
+          }
+        }
+      }
+    }
+    Eigen::SparseMatrix<double> reg_mat(unknowns, unknowns);
+    reg_mat.setFromTriplets(reg.begin(), reg.end());
+    hess += reg_mat;
+
+    // Levenberg-Marquardt: a failed step raises the damping and tries again.
+    const auto cost_of = [&](const Analysis& a, const std::vector<Vec3>& delta) {
+      double c = objective(a, targets, delta, first, dt, o, weight);
+      for (std::size_t k = first; k < n; ++k) {
+        bool ok = true;
+        double over[2];
+        rotate_waist(motion.frames[k], delta[k], ok, over);
+        for (const double v : over) c += v > 0.0 ? kReachWeight * kReachWeight * v * v : 0.0;
+      }
+      return c;
+    };
+    const double cost0 = cost_of(now, r.correction);
+    bool accepted = false;
+    for (int attempt = 0; attempt < 8 && !accepted; ++attempt) {
+      Eigen::SparseMatrix<double> damped = hess;
+      for (Eigen::Index i = 0; i < unknowns; ++i) damped.coeffRef(i, i) += damping * (1.0 + hess.coeff(i, i));
+      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(damped);
+      if (solver.info() != Eigen::Success) {
+        damping *= 10.0;
+        continue;
+      }
+      const Eigen::VectorXd step = solver.solve(rhs);
+      std::vector<Vec3> trial = r.correction;
+      for (std::size_t k = 0; k < m; ++k) {
+        Vec3 d = trial[first + k] + step.segment<3>(static_cast<Eigen::Index>(3 * k));
+        if (d.norm() > o.max_correction_rad) d *= o.max_correction_rad / d.norm();
+        trial[first + k] = d;
+      }
+      HumanMotion cand = corrected_motion(motion, trial, unreachable);
+      Analysis ca = analyse(cand, o.analysis, &contacts);
+      if (ca.ok() && cost_of(ca, trial) < cost0) {
+        r.correction = std::move(trial);
+        now = std::move(ca);
+        accepted = true;
+        damping = std::max(damping / 3.0, 1e-9);
+      } else {
+        damping *= 10.0;
+      }
+    }
+    if (!accepted) break;  // no step lowers the cost: as good as it gets
+  }
+
+  r.corrected = corrected_motion(motion, r.correction, unreachable);
+  r.after = analyse(r.corrected, o.analysis, &contacts);
+  r.unsolved.assign(n, false);
+  for (std::size_t k = first; k < n; ++k) {
+    const FrameAnalysis& f = r.after.frames[k];
+    const bool outside = f.analysed && !f.airborne && f.zmp_defined && f.outside_m > tol;
+    r.unsolved[k] = outside || unreachable[k];
+    r.frames_unsolved += r.unsolved[k] ? 1 : 0;
+    for (const Foot foot : {Foot::left, Foot::right}) {
+      const FootLandmarks fl = foot_landmarks(foot);
+      for (const Landmark l : {fl.ankle, fl.toe_joint, fl.toe_tip, fl.heel}) {
+        r.max_foot_displacement_m = std::max(r.max_foot_displacement_m,
+                                             (r.corrected.frames[k].p[index(l)] - motion.frames[k].p[index(l)]).norm());
+      }
+    }
+  }
+  return r;
+}
+
+}  // namespace tonus::balance
