@@ -114,7 +114,7 @@ Rms noise_gain(const std::function<Response(double)>& response) {
   return {std::sqrt(sum.p / kPoints), std::sqrt(sum.v / kPoints), std::sqrt(sum.a / kPoints)};
 }
 
-Signal polynomial(std::vector<double> c) {
+Signal polynomial(const std::vector<double>& c) {
   Signal s;
   s.p = [c](double t) {
     double r = 0.0;

@@ -44,7 +44,7 @@ Rms noise_gain(const std::function<Response(double)>& response);
 struct Signal {
   std::function<double(double)> p, v, a;
 };
-Signal polynomial(std::vector<double> coefficients);  // sum c_i t^i
+Signal polynomial(const std::vector<double>& coefficients);  // sum c_i t^i
 Signal sinusoid(double amplitude, double freq_hz, double phase);
 Signal gaussian_bump(double height, double centre_s, double width_s);
 // A foot-like step: rests, moves `distance` along a minimum-jerk profile in

@@ -25,8 +25,8 @@ struct Errors {
   double vel_interior = 0.0, vel_ends = 0.0, acc_interior = 0.0, acc_ends = 0.0;
 };
 
-// A clean sinusoid of `freq` Hz over 4 s (plus a phase, so the ends do not sit
-// on a zero crossing), errors relative to A w and A w^2.
+// A clean sinusoid of `freq` Hz over 4 s, errors relative to A w and A w^2,
+// worst over eight phases.
 Errors sinusoid_errors(Method m, double rate_hz, double freq_hz, const Params& base = {});
 
 // Errors on any signal over `seconds` (absolute, in the signal's units).

@@ -8,6 +8,7 @@
 
 #include "tables.hpp"
 #include "tonus/host/derivatives/batch.hpp"
+#include "tonus/host/derivatives/fixed_lag.hpp"
 
 using namespace tonus::derivatives;
 using namespace tonus::derivatives::test;
@@ -64,5 +65,51 @@ TEST_CASE("tables: human-like signals" * doctest::skip()) {
       }
       std::printf("\n");
     }
+  }
+}
+
+TEST_CASE("tables: fixed-lag error against lag" * doctest::skip()) {
+  std::printf("\nFixed lag, fc = 6 Hz. noise: RMS acc difference to the batch smoother on 2 mm noise, / the batch's\n");
+  std::printf(
+      "own noise RMS; step: max |acc error| on a clean foot step (peak 11.5 m/s^2), m/s^2; noisy step: RMS acc\n");
+  std::printf("error with 2 mm noise, m/s^2 (batch kalman in the last row)\n\n");
+  std::printf(
+      "| rate | lag (frames) | lag (ms) | noise: diff / batch noise | clean step: max acc error | noisy step: RMS acc "
+      "error |\n");
+  std::printf("|---|---|---|---|---|---|\n");
+  for (double rate : {30.0, 120.0}) {
+    const double dt = 1.0 / rate;
+    const std::size_t n = static_cast<std::size_t>(20 * rate);
+    std::vector<double> noise(n, 0.0);
+    add_noise(noise, 0.002, 5);
+    const Signal step = min_jerk_step(0.5, 1.0, 0.5);
+    const std::size_t ns = static_cast<std::size_t>(2.5 * rate);
+    const Pva t = truth(step, ns, dt);
+    std::vector<double> noisy = sample(step, ns, dt);
+    add_noise(noisy, 0.002, 8);
+    const Result batch_noise = differentiate(noise, dt, Params{.method = Method::kalman});
+    const double floor = rms_error(batch_noise.acc, std::vector<double>(n, 0.0), 50, n - 50);
+    const auto run = [&](std::size_t lag, const std::vector<double>& y) {
+      auto f = FixedLag::create(dt, {}, lag).smoother;
+      std::vector<double> acc(y.size(), 0.0);
+      for (double v : y) {
+        const Estimate e = f->push(v);
+        if (e.valid) acc[e.index] = e.acc;
+      }
+      for (std::size_t back = lag; back-- > 0;) acc[f->estimate(back).index] = f->estimate(back).acc;
+      return acc;
+    };
+    const std::size_t skip = static_cast<std::size_t>(kEndSeconds * rate);
+    for (std::size_t lag : {0u, 1u, 2u, 3u, 5u, 10u, 15u, 20u, 30u}) {
+      const double d = rms_error(run(lag, noise), batch_noise.acc, 50, n - 50) / floor;
+      const double clean = max_error(run(lag, sample(step, ns, dt)), t.a, skip, ns - skip);
+      const double noisy_err = rms_error(run(lag, noisy), t.a, skip, ns - skip);
+      std::printf("| %g | %zu | %.0f | %.3g | %.3g | %.3g |\n", rate, lag, 1000.0 * static_cast<double>(lag) * dt, d,
+                  clean, noisy_err);
+    }
+    const Result bc = differentiate(sample(step, ns, dt), dt, Params{.method = Method::kalman});
+    const Result bn = differentiate(noisy, dt, Params{.method = Method::kalman});
+    std::printf("| %g | batch | | 0 | %.3g | %.3g |\n", rate, max_error(bc.acc, t.a, skip, ns - skip),
+                rms_error(bn.acc, t.a, skip, ns - skip));
   }
 }

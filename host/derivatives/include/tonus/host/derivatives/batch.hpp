@@ -3,6 +3,13 @@
 // Params (default kalman_spline: RTS-smoothed positions, then a cubic spline
 // through them, differentiated analytically).
 //
+// Accuracy (docs/derivatives.md has the tables): in the interior the Kalman
+// methods attenuate content at f by (f/fc)^6 / (1 + (f/fc)^6) and leave
+// sigma * sqrt(w^5 dt / 18) of acceleration noise (w = 2 pi fc; 0.38 m/s^2 for
+// 2 mm at 120 Hz); within ~0.15 s of either end they see one side only and
+// err by up to 2 J tau in acceleration and 2 J tau^2 in velocity (J: the jerk
+// there, tau = 1 / w), nothing if the motion is at rest there.
+//
 // Missing samples: with the Kalman methods a NaN or infinite sample is missing
 // data (a mocap gap): the filter skips its update and the smoother bridges the
 // gap (a quintic-like curve that joins both sides with continuous p, v, a);
@@ -31,7 +38,8 @@ struct Stats {
 };
 
 // Where to write the results; each view may be empty (size 0) to skip it,
-// otherwise it must hold as many elements as the input.
+// otherwise it must hold as many elements as the input. Outputs may alias the
+// input (it is copied first), not each other.
 struct Outputs {
   Strided<double> pos = {};
   Strided<double> vel = {};
@@ -53,8 +61,8 @@ struct Result {
 Result differentiate(std::span<const double> x, double dt_s, const Params& params = {});
 
 // Convenience: a series of points, each coordinate processed independently.
-// Stats add up over the coordinates (a NaN point counts three times); the
-// status index is the sample's.
+// Stats add up over the coordinates (a NaN point counts three times; the
+// longest gap is the longest of any coordinate); the status index is the sample's.
 struct Result3 {
   Status status;
   Stats stats;
