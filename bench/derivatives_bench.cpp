@@ -26,7 +26,7 @@ std::vector<double> series(std::size_t n) {
 void BM_Batch(benchmark::State& state, Method method) {
   const std::vector<double> y = series(static_cast<std::size_t>(state.range(0)));
   const tonus::derivatives::Params params{.method = method};
-  for (auto _ : state) {
+  for (auto _ : state) {  // NOLINT(clang-analyzer-deadcode.DeadStores): Google Benchmark's loop idiom
     auto r = tonus::derivatives::differentiate(y, 1.0 / 120, params);
     benchmark::DoNotOptimize(r.acc.data());
   }
@@ -41,7 +41,7 @@ void BM_FixedLagPush(benchmark::State& state) {
   const std::vector<double> y = series(4096);
   auto f = tonus::derivatives::FixedLag::create(1.0 / 120, {}, static_cast<std::size_t>(state.range(0))).smoother;
   std::size_t k = 0;
-  for (auto _ : state) {
+  for (auto _ : state) {  // NOLINT(clang-analyzer-deadcode.DeadStores): Google Benchmark's loop idiom
     const auto e = f->push(y[k++ & 4095]);
     benchmark::DoNotOptimize(e.acc);
   }

@@ -86,7 +86,7 @@ TEST_CASE("at the end of a stream, estimate(back) gives the rest of the batch re
 
 TEST_CASE("the fixed-lag result converges to the full batch result as the lag grows") {
   // Documented look-ahead (docs/derivatives.md): with fc = 6 Hz the acceleration is within 10 % of
-  // the noise of the batch result after 0.15 s of lag (5 frames at 30 Hz, 18 at 120 Hz).
+  // the noise of the batch result after 1/6 s of lag (5 frames at 30 Hz, 20 at 120 Hz).
   for (double rate : {30.0, 120.0}) {
     const double dt = 1.0 / rate;
     const std::size_t n = static_cast<std::size_t>(20 * rate);

@@ -7,8 +7,8 @@
 // what batch Method::kalman gives at k - lag for the series x[0..k] (to
 // rounding); against the batch result of the whole series the difference is the
 // information the samples after k carry, which decays with the lag (measured in
-// docs/derivatives.md, fc = 6 Hz: 0.15 s of lag, 5 frames at 30 Hz or 18 at
-// 120 Hz, brings it within 10 % of the batch's own noise; 0.08 s within ~30 %).
+// docs/derivatives.md, fc = 6 Hz: 1/6 s of lag, 5 frames at 30 Hz or 20 at
+// 120 Hz, brings it within 10 % of the batch's own noise; 1/12 s within ~30 %).
 // The output is the smoother's own states (Method::kalman): a cubic spline
 // needs the whole series; in the interior they differ from kalman_spline by
 // less than a tenth of the noise at 120 Hz (docs/derivatives.md).

@@ -46,10 +46,10 @@ struct Params {
   // predicted_noise(); the smoothed values do not depend on it.
   double noise_sigma = 0.002;
   // -6 dB frequency of the smoother, Hz. 6 Hz passes motion below 2.5 Hz within
-  // 0.5 % and below 3.7 Hz within 5 %, and minimises the acceleration error of
-  // a brisk foot step (0.5 m in 0.5 s) under 2 mm noise at 60..240 Hz. Raise it
-  // for fast motion (kicks: 8-10 Hz) at the price of acceleration noise growing
-  // as fc^2.5 (predicted_noise(); docs/derivatives.md).
+  // 0.5 % and below 3.7 Hz within 5 %, and is near the best for a brisk foot
+  // step (0.5 m in 0.5 s) under 2 mm noise at 60..240 Hz; postural sway prefers
+  // 4 Hz, kicks and impacts 8-12 Hz, at the price of acceleration noise growing
+  // as fc^2.5 (predicted_noise(); docs/derivatives.md has the table).
   double cutoff_hz = 6.0;
   SplineEnd spline_end = SplineEnd::not_a_knot;
   // Kalman methods: a finite sample whose innovation (distance from the filter's
