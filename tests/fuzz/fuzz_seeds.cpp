@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -90,6 +91,31 @@ void append_frame(std::vector<std::uint8_t>& out, const CanFrame& f) {
   out.insert(out.end(), f.data.begin(), f.data.end());
 }
 
+// Small BVH texts in the layouts real exporters write: CMU-like (CRLF, a
+// 6-channel root, ZYX joints, ".0083333"), Bandai-like (tabs, six channels
+// on every joint, a tab after "Frames:"), and names with blanks, several End
+// Sites, a joint without channels and interleaved channels.
+constexpr const char* kBvhSeeds[] = {
+    "HIERARCHY\r\nROOT Hips\r\n{\r\n\tOFFSET 0.00000 0.00000 0.00000\r\n"
+    "\tCHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation \r\n"
+    "\tJOINT LeftUpLeg\r\n\t{\r\n\t\tOFFSET 1.65674 -1.80282 0.62477\r\n"
+    "\t\tCHANNELS 3 Zrotation Yrotation Xrotation\r\n\t\tEnd Site\r\n\t\t{\r\n"
+    "\t\t\tOFFSET 0.00000 -0.00000 1.11249\r\n\t\t}\r\n\t}\r\n}\r\nMOTION\r\nFrames: 2\n"
+    "Frame Time: .0083333\n10.4194 16.7048 -30.1003 0 0 0 0 -21 0\r\n"
+    "10.5 16.7 -30.1 -1.5 2.25 3 4 5 -6.0000\r\n",
+    "HIERARCHY\nROOT joint_Root\n{\n\tOFFSET 0.0 0.0 0.0\n"
+    "\tCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation \n\tJOINT Hips\n\t{\n"
+    "\t\tOFFSET -0.726466 93.3139 -2.00062\n\t\tCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation "
+    "Yrotation \n\t\tEnd Site\n\t\t{\n\t\t\tOFFSET 0.0 0.0 0.0\n\t\t}\n\t}\n}\nMOTION\nFrames:\t1\n"
+    "Frame Time:\t0.0333333\n0.000000 0.000000 0.000000 0.000000 0.000000 -0.000000 0.467354 92.389100 "
+    "450.294000 -80.778900 -7.404020 160.050000 \n",
+    "HIERARCHY\nROOT Bip01\n{\n OFFSET 0 0 0\n CHANNELS 3 Xposition Yposition Zposition\n"
+    " JOINT Bip01 L Thigh {\n  OFFSET 1 0 0\n  CHANNELS 0\n  End Site\n  {\n   OFFSET 0 -1 0\n  }\n"
+    "  End site {\n   OFFSET 0 -2 7.7e-06\n  }\n }\n JOINT Leaf\n {\n  OFFSET 0 1 0\n"
+    "  CHANNELS 4 Yrotation Xposition Zrotation Xrotation\n }\n}\nMOTION\nFrames: 3\nFrame Time: 0.01\n"
+    "1 2 3 45 +1 1e1 -2.5\n\n1 2 3 45 1 1E-3 .5\n-1 -2 -3 -45 -1 -1 -.5",
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -98,7 +124,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path root(argv[1]);
-  for (const char* t : {"stream", "command", "hid_descriptor", "can", "candump"}) fs::create_directories(root / t);
+  for (const char* t : {"stream", "command", "hid_descriptor", "can", "candump", "bvh"})
+    fs::create_directories(root / t);
   int n = 0;
 
   for (auto [g, c] : {std::pair<std::uint8_t, std::uint8_t>{4, 8}, {1, 1}, {6, 16}, {5, 13}}) {
@@ -133,6 +160,10 @@ int main(int argc, char** argv) {
     std::array<char, candump::kMaxLine> line{};
     std::size_t len = 0;
     if (candump::format(rec, line, len) == Error::ok) write(root / "candump", n, {line.begin(), line.begin() + len});
+  }
+  for (const char* bvh : kBvhSeeds) {
+    const auto* bytes = reinterpret_cast<const std::uint8_t*>(bvh);
+    write(root / "bvh", n, {bytes, bytes + std::strlen(bvh)});
   }
   std::printf("fuzz_seeds: wrote %d seeds under %s\n", n, root.c_str());
   return 0;
