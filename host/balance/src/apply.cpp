@@ -9,11 +9,6 @@ using sim::Bone;
 using Vec3d = Eigen::Vector3d;
 using Quatd = Eigen::Quaterniond;
 
-Quatd exp_map(const Vec3& v) {
-  const double a = v.norm();
-  return a < 1e-12 ? Quatd::Identity() : Quatd(Eigen::AngleAxisd(a, v / a));
-}
-
 // A joint's new local rotation from its parent's new global one and its own new global one.
 Quatd local_from(const std::vector<motion::JointPose>& poses, const std::vector<Quatd>& global,
                  const motion::Clip& clip, std::size_t joint) {
@@ -25,8 +20,9 @@ Quatd local_from(const std::vector<motion::JointPose>& poses, const std::vector<
 
 }  // namespace
 
-AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeometry& g,
-                                   const std::vector<Vec3>& correction, std::size_t first_frame) {
+AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeometry& g, const HumanMotion& human,
+                                   const std::vector<Vec3>& correction) {
+  const std::size_t first_frame = human.first_frame;
   AppliedCorrection out;
   out.clip = clip;
   const auto bone = [&](Bone b) { return g.map.joint[sim::index(b)]; };
@@ -38,7 +34,7 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
     out.error = "the hips joint '" + hj.name + "' has no position channels: the waist cannot turn about the hip joints";
     return out;
   }
-  if (correction.size() != clip.frame_count) {
+  if (correction.size() != clip.frame_count || human.size() != clip.frame_count) {
     out.error = "one correction per frame is needed";
     return out;
   }
@@ -52,16 +48,18 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
       out.error = "forward kinematics failed at frame " + std::to_string(f);
       return out;
     }
-    if (correction[f].norm() == 0.0) continue;
-    const Quatd r = to_int.conjugate() * exp_map(correction[f]) * to_int;  // the turn in the file's frame
-    const auto p = [&](Bone b) { return poses[static_cast<std::size_t>(bone(b))].position; };
-    const Vec3d pivot = 0.5 * (p(Bone::LeftUpperLeg) + p(Bone::RightUpperLeg));
+    if (f < first_frame || correction[f].norm() == 0.0) continue;
+    // The same turn and drop the filter used, in the file's frame and units.
+    const WaistTurn turn = waist_turn(human.frames[f], correction[f]);
+    const Quatd r = to_int.conjugate() * turn.rotation * to_int;
+    const Vec3d pivot = to_int.conjugate() * turn.pivot / g.metres_per_unit;
+    const Vec3d drop = to_int.conjugate() * Vec3d(0, 0, -turn.drop_m) / g.metres_per_unit;
     global.resize(poses.size());
     for (std::size_t j = 0; j < poses.size(); ++j) global[j] = poses[j].rotation;
     // The hips and everything on the pelvis turn rigidly: new hips rotation and position.
     const auto hu = static_cast<std::size_t>(hips);
     global[hu] = r * poses[hu].rotation;
-    const Vec3d hips_pos = pivot + r * (poses[hu].position - pivot);
+    const Vec3d hips_pos = pivot + r * (poses[hu].position - pivot) + drop;
     const int hp = clip.joints[hu].parent;
     const Quatd parent_rot = hp >= 0 ? poses[static_cast<std::size_t>(hp)].rotation : Quatd::Identity();
     const Vec3d parent_pos = hp >= 0 ? poses[static_cast<std::size_t>(hp)].position : Vec3d::Zero();
@@ -79,7 +77,7 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
       const auto tu = static_cast<std::size_t>(thigh), su = static_cast<std::size_t>(shank),
                  fu = static_cast<std::size_t>(foot);
       const Vec3d hip = poses[tu].position, knee = poses[su].position, ankle = poses[fu].position;
-      const Vec3d hip2 = pivot + r * (hip - pivot);
+      const Vec3d hip2 = pivot + r * (hip - pivot) + drop;
       const double l1 = (knee - hip).norm(), l2 = (ankle - knee).norm();
       const Vec3d d = ankle - hip2;
       double dist = d.norm();

@@ -55,9 +55,16 @@ Sole measure_sole(const HumanMotion& m, Foot foot, double ground_z, const Contac
   const double ball_ahead = fwd.norm();
   fwd.normalize();
   const Vec2 side(-fwd.y(), fwd.x());
+  // Foot length: Winter's 0.152 of the stature, the stature from the leg
+  // (hip to ankle 0.491 of it); longer if the skeleton's toe tip says so.
+  // (Skeletons place the toe joint anywhere from mid-foot to the ball, so it
+  // does not give the length.)
+  const Landmark hip = foot == Foot::left ? joint_of(sim::Bone::LeftUpperLeg) : joint_of(sim::Bone::RightUpperLeg);
+  const Landmark knee = foot == Foot::left ? joint_of(sim::Bone::LeftLowerLeg) : joint_of(sim::Bone::RightLowerLeg);
+  const double leg = (fr.p[index(knee)] - fr.p[index(hip)]).norm() + (ankle - fr.p[index(knee)]).norm();
+  double length = 0.152 / 0.491 * leg;
   const double tip_ahead = horizontal(tip - ankle).dot(fwd);
-  double length = ball_ahead / kBallAheadOfAnkle;
-  if (tip_ahead > ball_ahead + 0.01) length = tip_ahead / kTipAheadOfAnkle;  // a real toe tip: trust it
+  if (tip_ahead > ball_ahead + 0.01) length = std::max(length, tip_ahead / kTipAheadOfAnkle);
   if (opt.foot_length_m) length = *opt.foot_length_m;
   Sole s;
   s.length_m = length;

@@ -16,21 +16,25 @@ namespace {
 // body's mass share times its lever, and that times its height over g).
 constexpr double kSizeScale_m = 0.2;
 constexpr double kAccelScale_m = 0.02;
-// Metres of ZMP error that one metre of leg over-reach weighs like.
-constexpr double kReachWeight = 30.0;
+// The Jacobian keeps the acceleration operator's entries above this share of
+// its peak (the residuals always use the exact operator).
+constexpr double kBandThreshold = 1e-3;
 
 struct Targets {
   std::vector<bool> active;
   std::vector<Vec2> target;
 };
 
-HumanMotion corrected_motion(const HumanMotion& m, const std::vector<Vec3>& delta, std::vector<bool>& unreachable) {
+HumanMotion corrected_motion(const HumanMotion& m, const std::vector<Vec3>& delta, std::vector<bool>& unreachable,
+                             double* max_drop = nullptr) {
   HumanMotion out = m;  // (frames before first_frame stay as they are)
   unreachable.assign(m.size(), false);
   for (std::size_t t = m.first_frame; t < m.size(); ++t) {
-    bool ok = true;
-    out.frames[t] = rotate_waist(m.frames[t], delta[t], ok);
-    unreachable[t] = !ok;
+    double drop = 0.0;
+    bool reachable = true;
+    out.frames[t] = rotate_waist(m.frames[t], delta[t], &drop, &reachable);
+    unreachable[t] = !reachable;
+    if (max_drop != nullptr) *max_drop = std::max(*max_drop, std::abs(drop));
   }
   return out;
 }
@@ -87,7 +91,7 @@ AccelOperator accel_operator(std::size_t n, double dt, const derivatives::Params
   double peak = 0.0;
   for (const double v : probe.acc) peak = std::max(peak, std::abs(v));
   for (std::size_t k = 0; k < n; ++k) {
-    if (std::abs(probe.acc[k]) > 1e-7 * peak) op.band = std::max(op.band, k > mid ? k - mid : mid - k);
+    if (std::abs(probe.acc[k]) > kBandThreshold * peak) op.band = std::max(op.band, k > mid ? k - mid : mid - k);
   }
   op.band = std::min(op.band, n - 1);
   const std::size_t w = 2 * op.band + 1;
@@ -144,11 +148,12 @@ FilterResult balance_filter(const HumanMotion& motion, const FilterOptions& o, F
   }
   const ContactTrack& contacts = r.before.contacts;  // the feet do not move: neither do their contacts
   r.correction.assign(n, Vec3::Zero());
-  std::vector<bool> unreachable;
   Analysis now = r.before;
+  std::vector<bool> unreachable(n, false);
   const double tol = o.analysis.tolerance_m;
   const std::size_t m = n - first;
   const AccelOperator op = accel_operator(m, dt, o.analysis.derivatives);
+  r.operator_band = op.band;
   std::vector<double> weight(n, 1.0);  // grows for frames that stay outside (penalty continuation)
   double damping = 1e-6;               // Levenberg-Marquardt
 
@@ -162,28 +167,22 @@ FilterResult balance_filter(const HumanMotion& motion, const FilterOptions& o, F
       if (targets.active[k] && f.outside_m > tol) weight[k] = std::min(weight[k] * 2.0, 1e4);
     }
 
-    // Derivatives of every frame's segment positions and leg over-reach with
-    // respect to its own correction (numerically: the IK is cheap).
+    // Derivatives of every frame's segment positions with respect to its own
+    // correction (numerically: the turn and the leg IK are cheap).
     using Triplet = Eigen::Triplet<double>;
     std::vector<Triplet> jac;
     std::vector<double> residual;
     std::size_t row = 0;
     const double h = 1e-6;
     std::vector<std::array<Vec3, kSegmentParts>> dcom(3 * m);
-    std::vector<std::array<double, 2>> reach(m), dreach(3 * m);
     for (std::size_t k = first; k < n; ++k) {
       const SegmentFrame& base = now.segments[k];
-      bool ok = true;
-      rotate_waist(motion.frames[k], r.correction[k], ok, reach[k - first].data());
       for (int e = 0; e < 3; ++e) {
         Vec3 d = r.correction[k];
         d(e) += h;
-        std::array<double, 2> moved_reach{};
-        const SegmentFrame moved =
-            place_segments(now.mass, rotate_waist(motion.frames[k], d, ok, moved_reach.data()).p);
+        const SegmentFrame moved = place_segments(now.mass, rotate_waist(motion.frames[k], d).p);
         const std::size_t idx = 3 * (k - first) + static_cast<std::size_t>(e);
         for (std::size_t i = 0; i < kSegmentParts; ++i) dcom[idx][i] = (moved[i].com - base[i].com) / h;
-        for (std::size_t leg = 0; leg < 2; ++leg) dreach[idx][leg] = (moved_reach[leg] - reach[k - first][leg]) / h;
       }
     }
     // ZMP residuals: a frame's ZMP moves with its own correction (its
@@ -212,19 +211,6 @@ FilterResult balance_filter(const HumanMotion& motion, const FilterOptions& o, F
       }
       row += 2;
     }
-    // Leg over-reach residuals (one-sided): keep every leg able to reach its foot.
-    for (std::size_t kk = 0; kk < m; ++kk) {
-      for (std::size_t leg = 0; leg < 2; ++leg) {
-        if (reach[kk][leg] <= 0.0) continue;
-        residual.push_back(kReachWeight * reach[kk][leg]);
-        for (int e = 0; e < 3; ++e) {
-          jac.emplace_back(static_cast<int>(row), static_cast<int>(3 * kk + static_cast<std::size_t>(e)),
-                           kReachWeight * dreach[3 * kk + static_cast<std::size_t>(e)][leg]);
-        }
-        ++row;
-      }
-    }
-
     // Normal equations: J^T J + smoothness (second difference) + size + damping.
     const auto unknowns = static_cast<Eigen::Index>(3 * m);
     Eigen::SparseMatrix<double> j_mat(static_cast<Eigen::Index>(row), unknowns);
@@ -262,17 +248,15 @@ FilterResult balance_filter(const HumanMotion& motion, const FilterOptions& o, F
     hess += reg_mat;
 
     // Levenberg-Marquardt: a failed step raises the damping and tries again.
-    const auto cost_of = [&](const Analysis& a, const std::vector<Vec3>& delta) {
+    // A frame whose legs cannot reach their feet costs as much as a metre of ZMP
+    // error: steps into it are refused, so a foot is never moved by the filter
+    // unless the captured pose already forces it.
+    const auto cost_of = [&](const Analysis& a, const std::vector<Vec3>& delta, const std::vector<bool>& out_of_reach) {
       double c = objective(a, targets, delta, first, dt, o, weight);
-      for (std::size_t k = first; k < n; ++k) {
-        bool ok = true;
-        double over[2];
-        rotate_waist(motion.frames[k], delta[k], ok, over);
-        for (const double v : over) c += v > 0.0 ? kReachWeight * kReachWeight * v * v : 0.0;
-      }
+      for (std::size_t k = first; k < n; ++k) c += out_of_reach[k] ? 1.0 : 0.0;
       return c;
     };
-    const double cost0 = cost_of(now, r.correction);
+    const double cost0 = cost_of(now, r.correction, unreachable);
     bool accepted = false;
     for (int attempt = 0; attempt < 8 && !accepted; ++attempt) {
       Eigen::SparseMatrix<double> damped = hess;
@@ -289,9 +273,11 @@ FilterResult balance_filter(const HumanMotion& motion, const FilterOptions& o, F
         if (d.norm() > o.max_correction_rad) d *= o.max_correction_rad / d.norm();
         trial[first + k] = d;
       }
-      HumanMotion cand = corrected_motion(motion, trial, unreachable);
+      std::vector<bool> cand_unreachable;
+      HumanMotion cand = corrected_motion(motion, trial, cand_unreachable);
       Analysis ca = analyse(cand, o.analysis, &contacts);
-      if (ca.ok() && cost_of(ca, trial) < cost0) {
+      if (ca.ok() && cost_of(ca, trial, cand_unreachable) < cost0) {
+        unreachable = std::move(cand_unreachable);
         r.correction = std::move(trial);
         now = std::move(ca);
         accepted = true;
@@ -303,14 +289,15 @@ FilterResult balance_filter(const HumanMotion& motion, const FilterOptions& o, F
     if (!accepted) break;  // no step lowers the cost: as good as it gets
   }
 
-  r.corrected = corrected_motion(motion, r.correction, unreachable);
+  r.corrected = corrected_motion(motion, r.correction, unreachable, &r.max_drop_m);
   r.after = analyse(r.corrected, o.analysis, &contacts);
   r.unsolved.assign(n, false);
   for (std::size_t k = first; k < n; ++k) {
     const FrameAnalysis& f = r.after.frames[k];
     const bool outside = f.analysed && !f.airborne && f.zmp_defined && f.outside_m > tol;
-    r.unsolved[k] = outside || unreachable[k];
-    r.frames_unsolved += r.unsolved[k] ? 1 : 0;
+    const bool at_limit = r.correction[k].norm() >= o.max_correction_rad * (1.0 - 1e-9);
+    r.unsolved[k] = outside || (at_limit && f.outside_m > -o.margin_m) || unreachable[k];
+    r.frames_unsolved += r.unsolved[k] ? 1U : 0U;
     for (const Foot foot : {Foot::left, Foot::right}) {
       const FootLandmarks fl = foot_landmarks(foot);
       for (const Landmark l : {fl.ankle, fl.toe_joint, fl.toe_tip, fl.heel}) {

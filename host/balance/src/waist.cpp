@@ -1,8 +1,10 @@
-// The waist rotation of one frame: the pelvis and everything above turn about
-// the midpoint of the hip joints (so that pitching the pelvis leaves both hip
-// joints in place, and the root joint moves with the turn); each leg is
-// re-solved by two-bone IK between its moved hip joint and its unmoved ankle,
-// the knee staying in its captured plane.
+// The waist correction of one frame: the pelvis and everything above turn
+// about the midpoint of the hip joints (so pitching leaves both hip joints in
+// place; the root joint moves with the turn), lowered by the few millimetres a
+// straight stance leg needs to still reach its foot; each leg is re-solved by
+// two-bone IK between its moved hip joint and its unmoved ankle, the knee
+// staying in its captured plane.
+#include <algorithm>
 #include <cmath>
 
 #include "tonus/host/balance/filter.hpp"
@@ -19,8 +21,8 @@ constexpr Bone kUpper[] = {Bone::Hips,      Bone::Spine,         Bone::Chest,   
 constexpr Landmark kUpperExtras[] = {Landmark::HeadTop, Landmark::LeftHandTip, Landmark::RightHandTip,
                                      Landmark::MidHip};
 
-// A leg is kept from straightening beyond this share of its length, which
-// would leave the IK no room (the filter penalises going past it).
+// A leg is kept from straightening beyond this share of its length (the IK
+// keeps a sliver of knee bend rather than a singular straight leg).
 constexpr double kReach = 0.999;
 
 Quat exp_map(const Vec3& v) {
@@ -29,47 +31,80 @@ Quat exp_map(const Vec3& v) {
   return Quat(Eigen::AngleAxisd(a, v / a));
 }
 
+struct Leg {
+  Bone thigh, shank, ankle;
+};
+constexpr Leg kLegs[2] = {{Bone::LeftUpperLeg, Bone::LeftLowerLeg, Bone::LeftFoot},
+                          {Bone::RightUpperLeg, Bone::RightLowerLeg, Bone::RightFoot}};
+
+Vec3 at(const MotionFrame& f, Bone b) { return f.p[sim::index(b)]; }
+
 }  // namespace
 
-MotionFrame rotate_waist(const MotionFrame& in, const Vec3& delta, bool& reachable, double* overreach_m) {
-  reachable = true;
-  if (overreach_m != nullptr) overreach_m[0] = overreach_m[1] = 0.0;
-  MotionFrame out = in;
-  const Quat r = exp_map(delta);
-  const Vec3 c = in.p[index(Landmark::MidHip)];
-  for (const Bone b : kUpper) {
-    out.p[sim::index(b)] = c + r * (in.p[sim::index(b)] - c);
-    if (b != Bone::LeftUpperLeg && b != Bone::RightUpperLeg)
-      out.rotation[sim::index(b)] = r * in.rotation[sim::index(b)];
-  }
-  for (const Landmark l : kUpperExtras) out.p[index(l)] = c + r * (in.p[index(l)] - c);
-
-  for (const Foot foot : {Foot::left, Foot::right}) {
-    const Bone thigh = foot == Foot::left ? Bone::LeftUpperLeg : Bone::RightUpperLeg;
-    const Bone shank = foot == Foot::left ? Bone::LeftLowerLeg : Bone::RightLowerLeg;
-    const Bone ankle_bone = foot == Foot::left ? Bone::LeftFoot : Bone::RightFoot;
-    const Vec3 hip = in.p[sim::index(thigh)], knee = in.p[sim::index(shank)], ankle = in.p[sim::index(ankle_bone)];
-    const Vec3 hip2 = out.p[sim::index(thigh)];
-    const double l1 = (knee - hip).norm(), l2 = (ankle - knee).norm();
-    Vec3 d = ankle - hip2;
-    double dist = d.norm();
-    if (dist < 1e-9) continue;
-    const Vec3 u = d / dist;
-    if (overreach_m != nullptr) overreach_m[static_cast<std::size_t>(foot)] = dist - kReach * (l1 + l2);
-    if (dist > l1 + l2) {
-      reachable = false;  // the knee straightens; the foot cannot be kept
-      dist = l1 + l2;
+WaistTurn waist_turn(const MotionFrame& in, const Vec3& delta) {
+  WaistTurn w;
+  w.rotation = exp_map(delta);
+  w.pivot = in.p[index(Landmark::MidHip)];
+  // The vertical shift of the pelvis, closest to none, that keeps both hips
+  // within kReach of their legs' lengths from their ankles: each leg allows an
+  // interval of shifts; take the common one.
+  double lo = -1e9, hi = 1e9;
+  for (const Leg& leg : kLegs) {
+    const Vec3 hip = at(in, leg.thigh), knee = at(in, leg.shank), ankle = at(in, leg.ankle);
+    // As far as 99.9 % of the leg, or as far as the capture already has it (a kick's straight leg).
+    const double reach = std::max(kReach * ((knee - hip).norm() + (ankle - knee).norm()), (ankle - hip).norm());
+    const Vec3 d = w.pivot + w.rotation * (hip - w.pivot) - ankle;
+    const double horizontal2 = d.x() * d.x() + d.y() * d.y();
+    if (horizontal2 >= reach * reach) {  // out of reach whatever the height
+      w.reachable = false;
+      continue;
     }
+    const double half = std::sqrt(reach * reach - horizontal2);
+    lo = std::max(lo, -half - d.z());
+    hi = std::min(hi, half - d.z());
+  }
+  if (lo > hi) {
+    w.reachable = false;
+    w.drop_m = -0.5 * (lo + hi);  // as close to both as a single shift gets
+  } else {
+    w.drop_m = -std::clamp(0.0, lo, hi);
+  }
+  return w;
+}
+
+MotionFrame rotate_waist(const MotionFrame& in, const Vec3& delta, double* drop_m, bool* reachable) {
+  const WaistTurn w = waist_turn(in, delta);
+  if (drop_m != nullptr) *drop_m = w.drop_m;
+  if (reachable != nullptr) *reachable = w.reachable;
+  MotionFrame out = in;
+  const Vec3 down(0, 0, w.drop_m);
+  const auto move = [&](const Vec3& p) { return Vec3(w.pivot + w.rotation * (p - w.pivot) - down); };
+  for (const Bone b : kUpper) {
+    out.p[sim::index(b)] = move(in.p[sim::index(b)]);
+    if (b != Bone::LeftUpperLeg && b != Bone::RightUpperLeg)
+      out.rotation[sim::index(b)] = w.rotation * in.rotation[sim::index(b)];
+  }
+  for (const Landmark l : kUpperExtras) out.p[index(l)] = move(in.p[index(l)]);
+
+  for (const Leg& leg : kLegs) {
+    const Vec3 hip = at(in, leg.thigh), knee = at(in, leg.shank), ankle = at(in, leg.ankle);
+    const Vec3 hip2 = out.p[sim::index(leg.thigh)];
+    const double l1 = (knee - hip).norm(), l2 = (ankle - knee).norm();
+    const Vec3 d = ankle - hip2;
+    const double dist = std::min(d.norm(), l1 + l2);
+    if (dist < 1e-9) continue;
+    const Vec3 u = d.normalized();
     const double a = (l1 * l1 - l2 * l2 + dist * dist) / (2.0 * dist);
     const double h = std::sqrt(std::max(l1 * l1 - a * a, 0.0));
     Vec3 v = (knee - hip2) - (knee - hip2).dot(u) * u;  // towards the captured knee
     if (v.norm() < 1e-9) v = u.unitOrthogonal();
     v.normalize();
     const Vec3 knee2 = hip2 + a * u + h * v;
-    out.p[sim::index(shank)] = knee2;
-    out.rotation[sim::index(thigh)] = Quat::FromTwoVectors(knee - hip, knee2 - hip2) * in.rotation[sim::index(thigh)];
-    out.rotation[sim::index(shank)] =
-        Quat::FromTwoVectors(ankle - knee, ankle - knee2) * in.rotation[sim::index(shank)];
+    out.p[sim::index(leg.shank)] = knee2;
+    out.rotation[sim::index(leg.thigh)] =
+        Quat::FromTwoVectors(knee - hip, knee2 - hip2) * in.rotation[sim::index(leg.thigh)];
+    out.rotation[sim::index(leg.shank)] =
+        Quat::FromTwoVectors(ankle - knee, ankle - knee2) * in.rotation[sim::index(leg.shank)];
   }
   return out;
 }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "tonus/host/balance/convert.hpp"
+#include "tonus/host/balance/filter.hpp"
 
 namespace tonus::balance {
 
@@ -22,8 +23,9 @@ struct AppliedCorrection {
   [[nodiscard]] bool ok() const { return error.empty(); }
 };
 
-// `correction` has one rotation vector per frame (internal frame, radians).
+// `motion` is the clip's conversion (convert_motion) and `correction` the
+// filter's, one rotation vector per frame (internal frame, radians).
 AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeometry& geometry,
-                                   const std::vector<Vec3>& correction, std::size_t first_frame);
+                                   const HumanMotion& motion, const std::vector<Vec3>& correction);
 
 }  // namespace tonus::balance

@@ -5,8 +5,9 @@
 // the thighs and shanks follow the pelvis with a two-bone IK that keeps each
 // knee in its captured plane. The waist turns about the midpoint of the hip
 // joints: pitching it moves neither hip joint, while rolling it lifts one hip
-// and lowers the other, which a straight stance leg cannot follow; the filter
-// penalises such over-reach, so it corrects by pitch and yaw where it must.
+// and lowers the other; where a straight stance leg could not follow, the
+// pelvis is lowered by the millimetres it needs (the knee bends a little)
+// instead of the foot moving.
 //
 // The corrections (a rotation vector per frame, about the root joint, in the
 // world) are solved together by Gauss-Newton: the residuals are the ZMP's
@@ -29,10 +30,10 @@ namespace tonus::balance {
 struct FilterOptions {
   AnalysisOptions analysis;
   double margin_m = 0.01;           // targets this far inside the polygon
-  double max_correction_rad = 0.6;  // per frame; beyond it a frame is unsolved
+  double max_correction_rad = 1.0;  // per frame; a frame that needs more is unsolved
   double smoothness = 0.1;          // weight of the correction's angular acceleration (ZMP-equivalent metres)
   double size_weight = 0.05;        // weight of the correction's size (ZMP-equivalent metres)
-  int max_iterations = 40;
+  int max_iterations = 100;
 };
 
 struct FilterResult {
@@ -42,8 +43,10 @@ struct FilterResult {
   Analysis after;
   std::vector<bool> unsolved;  // per frame
   std::size_t frames_unsolved = 0;
-  double max_foot_displacement_m = 0.0;  // of the feet's landmarks (zero up to rounding unless a leg could not reach)
+  double max_foot_displacement_m = 0.0;  // of the feet's landmarks (zero up to rounding)
+  double max_drop_m = 0.0;               // the largest vertical pelvis shift the legs needed
   int iterations = 0;
+  std::size_t operator_band = 0;  // frames on each side a frame's acceleration depends on (the look-ahead)
   std::string error;
   [[nodiscard]] bool ok() const { return error.empty(); }
 };
@@ -54,11 +57,22 @@ using FilterProgress = void (*)(int iteration, std::size_t frames_outside, void*
 FilterResult balance_filter(const HumanMotion& motion, const FilterOptions& options, FilterProgress progress = nullptr,
                             void* user = nullptr);
 
-// One frame with the waist rotated by `delta` about the midpoint of the hip
-// joints, the pelvis and upper body following rigidly and the legs re-solved
-// to keep the feet. `reachable` is false when a leg had to stretch beyond its
-// length; `overreach_m` (two values, left and right), when given, receives how
-// far each hip-to-ankle distance exceeds 99.9 % of the leg's length (negative: slack).
-MotionFrame rotate_waist(const MotionFrame& frame, const Vec3& delta, bool& reachable, double* overreach_m = nullptr);
+// The waist correction of one frame: a turn by `delta` about the midpoint of
+// the hip joints, then a vertical shift of the pelvis and everything above it
+// (drop_m > 0: down) by the few millimetres a straight leg needs to keep
+// reaching its foot. `reachable` is false when no shift lets both legs reach
+// (a foot will move: the frame is flagged).
+struct WaistTurn {
+  Quat rotation = Quat::Identity();
+  Vec3 pivot = Vec3::Zero();
+  double drop_m = 0.0;
+  bool reachable = true;
+};
+WaistTurn waist_turn(const MotionFrame& frame, const Vec3& delta);
+
+// The frame with that correction applied: pelvis and upper body moved
+// rigidly, both legs re-solved by two-bone IK to keep their feet.
+MotionFrame rotate_waist(const MotionFrame& frame, const Vec3& delta, double* drop_m = nullptr,
+                         bool* reachable = nullptr);
 
 }  // namespace tonus::balance
