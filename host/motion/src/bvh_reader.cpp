@@ -58,7 +58,7 @@ class BvhReader {
 
   std::string what(std::size_t index) const {
     const Joint& j = out_.clip.joints[index];
-    return (j.end_site ? "End Site '" : "joint '") + j.name + "'";
+    return (j.end_site ? "End Site " : "joint ") + describe(j.name, false);  // quoted, control bytes escaped
   }
 
   bool read_hierarchy();
@@ -126,12 +126,12 @@ bool BvhReader::open_joint(int parent, std::string_view keyword) {
                           (brace ? std::string("'{'") : describe({}, cursor_.at_end())));
   }
   if (name == "{" || (name.size() >= 2 && name.back() == '{' && is_blank(name[name.size() - 2]))) {
-    return fail(line, "expected one '{' after joint '" + std::string(name) + "', found two");
+    return fail(line, "expected one '{' after joint " + describe(name, false) + ", found two");
   }
   Joint joint;
   joint.name = std::string(name);
   joint.parent = parent;
-  return add_entry(std::move(joint), brace, "joint '" + std::string(name) + "'");
+  return add_entry(std::move(joint), brace, "joint " + describe(name, false));
 }
 
 bool BvhReader::open_end_site() {

@@ -5,8 +5,8 @@
 // any letter case ("End Site", "End site"), "Frames:" and "Frame Time:"
 // followed by spaces or a tab, numbers such as ".0083333", "-0.00000",
 // "+1", "7.7e-06", joint names containing spaces (the rest of the line), and
-// blank lines among the frames. OFFSET and CHANNELS must keep their
-// arguments on their own line; each frame is one line.
+// blank lines among the frames, CHANNELS before OFFSET. OFFSET and CHANNELS
+// must keep their arguments on their own line; each frame is one line.
 // It refuses, with the 1-based line and what was expected and found: a
 // truncated file, missing braces, a second ROOT, unknown or repeated
 // channels, a CHANNELS count different from the names listed, more than 6
