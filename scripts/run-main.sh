@@ -14,3 +14,9 @@ build/release/bin/tonus demo --seconds 5 --loss 0.01 --duplication 0.002 --reord
 # The physics core: the humanoid standing on the ground, a 1 kg cube dropped
 # on its hand, a ball thrown at its chest; what happened and what it cost.
 build/release/bin/tonus physics --seconds 3
+
+# The ZMP balance filter on a bundled CMU walk (tests/data/SOURCES.md): the
+# ZMP checked against the feet's support polygon, the waist corrected where it
+# leaves it, the corrected clip, a JSON report and an SVG plot written.
+build/release/bin/tonus zmp tests/data/cmu_02_walk.bvh -o build/release/cmu_02_walk_balanced.bvh \
+  --json build/release/cmu_02_walk_balance.json --svg build/release/cmu_02_walk_balance.svg

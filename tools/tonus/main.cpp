@@ -5,6 +5,7 @@
 
 #include "physics_demo.hpp"
 #include "protocol_demo.hpp"
+#include "zmp_command.hpp"
 
 namespace {
 
@@ -38,7 +39,43 @@ int run(int argc, char** argv) {
       ->check(CLI::Range(0.0, 30.0));
   physics_cmd->add_option("--mjcf", physics.mjcf_path, "Write the scene as MuJoCo MJCF to this file");
 
+  tonus::tools::ZmpCommandOptions zmp;
+  CLI::App* zmp_cmd = app.add_subcommand(
+      "zmp", "Analyse a BVH clip's zero moment point and correct its balance (waist rotation, feet kept)");
+  zmp_cmd->add_option("input", zmp.input, "Input BVH file")->required();
+  zmp_cmd->add_option("-o,--output", zmp.output, "Write the corrected BVH here");
+  zmp_cmd->add_option("--csv", zmp.csv, "Write the ZMP before/after per frame as CSV");
+  zmp_cmd->add_option("--json", zmp.json, "Write a machine-readable report");
+  zmp_cmd->add_option("--svg", zmp.svg, "Plot the ZMP trajectories with the support intervals shaded");
+  zmp_cmd->add_option("--mapping", zmp.mapping, "Joint-name mapping file: lines 'HumanBodyBone = JointName'");
+  zmp_cmd->add_option("--unit", zmp.unit,
+                      "Length unit of the file: m, cm, mm, inch, cmu or metres per unit (default: guessed)");
+  zmp_cmd->add_option("--mass", zmp.body_mass_kg, "Body mass, kg")->check(CLI::Range(5.0, 500.0));
+  zmp_cmd->add_option("--sex", zmp.sex, "de Leva table: male or female");
+  zmp_cmd->add_option("--foot-length", zmp.foot_length_m, "Sole length, m (default: from the skeleton)")
+      ->check(CLI::Range(0.05, 0.5));
+  zmp_cmd->add_option("--ground-height", zmp.ground_height_m,
+                      "Ground height in the internal frame, m (default: estimated)");
+  zmp_cmd
+      ->add_option("--contact-height", zmp.contact_height_m,
+                   "A foot point is down below its resting height plus this, m")
+      ->check(CLI::Range(0.001, 0.5));
+  zmp_cmd->add_option("--contact-speed", zmp.contact_speed_mps, "... and slower than this, m/s")
+      ->check(CLI::Range(0.01, 5.0));
+  zmp_cmd->add_option("--derivative", zmp.derivative, "kalman_spline (default), kalman, spline or finite_difference");
+  zmp_cmd->add_option("--cutoff", zmp.cutoff_hz, "Smoothing cutoff, Hz")->check(CLI::Range(0.5, 100.0));
+  zmp_cmd->add_flag("--full-zmp", zmp.full_zmp, "Include the segments' angular momentum (default: particle form)");
+  zmp_cmd->add_option("--correction", zmp.correction, "Correction method: rotation (the waist rotation)");
+  zmp_cmd->add_option("--margin", zmp.margin_m, "Aim this far inside the support polygon, m")
+      ->check(CLI::Range(0.0, 0.05));
+  zmp_cmd->add_option("--max-correction", zmp.max_correction_rad, "Largest waist rotation per frame, rad")
+      ->check(CLI::Range(0.01, 2.0));
+  zmp_cmd->add_option("--iterations", zmp.max_iterations, "Solver iterations at most")->check(CLI::Range(0, 10000));
+  zmp_cmd->add_flag("--keep-tpose", zmp.keep_tpose, "Analyse a leading T-pose frame too");
+  zmp_cmd->add_flag("-q,--quiet", zmp.quiet, "No report on stdout");
+
   CLI11_PARSE(app, argc, argv);
+  if (zmp_cmd->parsed()) return tonus::tools::run_zmp_command(zmp);
   if (demo_cmd->parsed()) return tonus::tools::run_protocol_demo(demo);
   if (physics_cmd->parsed()) return tonus::tools::run_physics_demo(physics);
   return 0;

@@ -107,13 +107,30 @@ Vec3 mean(const std::vector<Vec3>& v) {
   return v.empty() ? c : Vec3(c / static_cast<double>(v.size()));
 }
 
+// The point's resting height around each frame: a low percentile of its
+// heights within +-kRestWindow_s, so a floor that is not quite level (a take
+// whose stance foot creeps up a few centimetres) is followed.
+constexpr double kRestWindow_s = 1.5;
+
+std::vector<double> resting_height(const std::vector<double>& height, std::size_t first, double dt) {
+  const auto half = static_cast<std::size_t>(kRestWindow_s / dt);
+  std::vector<double> rest(height.size(), 0.0), window;
+  for (std::size_t t = 0; t < height.size(); ++t) {
+    const std::size_t lo = std::max(first, t > half ? t - half : 0), hi = std::min(height.size(), t + half + 1);
+    window.assign(height.begin() + static_cast<std::ptrdiff_t>(std::min(lo, hi - 1)),
+                  height.begin() + static_cast<std::ptrdiff_t>(hi));
+    rest[t] = percentile(window, 0.05);
+  }
+  return rest;
+}
+
 // Low-and-slow with hysteresis over a series of heights and speeds.
-std::vector<bool> hysteresis(const std::vector<double>& height, const std::vector<double>& speed, double rest,
-                             const ContactOptions& o) {
+std::vector<bool> hysteresis(const std::vector<double>& height, const std::vector<double>& speed,
+                             const std::vector<double>& rest, const ContactOptions& o) {
   std::vector<bool> on(height.size(), false);
   bool state = false;
   for (std::size_t t = 0; t < height.size(); ++t) {
-    const double h = height[t] - rest;
+    const double h = height[t] - rest[t];
     if (state) {
       state = !(h > o.height_off_m || speed[t] > o.speed_off_mps);
     } else {
@@ -168,10 +185,8 @@ ContactTrack detect_contacts(const HumanMotion& m, const ContactOptions& opt) {
       return h;
     };
     const std::vector<double> hh = heights(heel), hb = heights(ball);
-    std::vector<double> rest_h(hh.begin() + static_cast<std::ptrdiff_t>(m.first_frame), hh.end());
-    std::vector<double> rest_b(hb.begin() + static_cast<std::ptrdiff_t>(m.first_frame), hb.end());
-    const std::vector<bool> heel_on = hysteresis(hh, speeds(heel), percentile(rest_h, 0.05), opt);
-    const std::vector<bool> ball_on = hysteresis(hb, speeds(ball), percentile(rest_b, 0.05), opt);
+    const std::vector<bool> heel_on = hysteresis(hh, speeds(heel), resting_height(hh, m.first_frame, m.dt_s), opt);
+    const std::vector<bool> ball_on = hysteresis(hb, speeds(ball), resting_height(hb, m.first_frame, m.dt_s), opt);
     for (std::size_t t = 0; t < m.size(); ++t) track.frames[t][fi] = {heel_on[t], ball_on[t]};
   }
   return track;

@@ -1,0 +1,67 @@
+// The balance filter on every shared mocap clip (two skeleton conventions:
+// walks, a run, jumps, a one-leg-stance kick, punches, an idle clip): after
+// the correction no analysed frame has its ZMP outside the support polygon
+// (1 mm tolerance), the written clip's feet have not moved (< 1 mm), and the
+// numbers are reported.
+#include <doctest/doctest.h>
+
+#include "balance_fixtures.hpp"
+#include "tonus/host/balance/apply.hpp"
+#include "tonus/host/balance/filter.hpp"
+
+using namespace tonus::balance;
+
+namespace {
+
+void check_clip(const std::string& name, const std::string& path) {
+  const test::Loaded l = test::load(path);
+  FilterOptions o;
+  const FilterResult f = balance_filter(l.conversion.motion, o);
+  REQUIRE_MESSAGE(f.ok(), f.error);
+  const AppliedCorrection applied = apply_correction(l.clip, l.conversion.geometry, l.conversion.motion, f.correction);
+  REQUIRE_MESSAGE(applied.ok(), applied.error);
+  // The written text, read back and analysed afresh (its own contacts): still balanced.
+  const tonus::motion::ReadResult back = tonus::motion::parse_bvh(tonus::motion::write_bvh(applied.clip, 6));
+  REQUIRE(back.ok());
+  ConvertOptions same_unit;
+  same_unit.metres_per_unit = l.conversion.geometry.metres_per_unit;
+  const Conversion again = convert_motion(back.clip, map_skeleton(back.clip), same_unit);
+  REQUIRE(again.ok());
+  const Analysis reread = analyse(again.motion, o.analysis);
+  REQUIRE(reread.ok());
+  double max_correction = 0.0;
+  for (const Vec3& d : f.correction) max_correction = std::max(max_correction, d.norm());
+  MESSAGE(name << ": " << f.before.summary.frames << " frames, outside before " << f.before.summary.frames_outside
+               << " (max " << f.before.summary.max_outside_m << " m), after " << f.after.summary.frames_outside
+               << ", after writing and re-reading " << reread.summary.frames_outside << "; airborne "
+               << f.before.summary.frames_airborne << ", unsolved " << f.frames_unsolved << ", feet moved "
+               << applied.max_foot_displacement_m << " m, RMS joint change " << applied.rms_joint_change_rad
+               << " rad, largest waist correction " << max_correction << " rad");
+  CHECK(f.after.summary.frames_outside == 0);
+  CHECK(f.after.summary.max_outside_m <= o.analysis.tolerance_m);
+  CHECK(reread.summary.frames_outside == 0);
+  CHECK(applied.max_foot_displacement_m < 1e-3);
+  CHECK(f.max_foot_displacement_m < 1e-3);
+  // Airborne frames are counted apart, never as outside.
+  CHECK(f.after.summary.frames_airborne == f.before.summary.frames_airborne);
+}
+
+}  // namespace
+
+TEST_CASE("balance: CMU walk (bundled)") { check_clip("cmu_02_walk", test::bundled_clip("cmu_02_walk.bvh")); }
+TEST_CASE("balance: CMU forward jumps") { check_clip("cmu_01_01_jumps", test::shared_clip("cmu_01_01_jumps.bvh")); }
+TEST_CASE("balance: Bandai Namco walk") {
+  check_clip("dataset-1_walk", test::shared_clip("dataset-1_walk_normal_001.bvh"));
+}
+TEST_CASE("balance: Bandai Namco run") {
+  check_clip("dataset-2_run", test::shared_clip("dataset-2_run_normal_010.bvh"));
+}
+TEST_CASE("balance: Bandai Namco kicks on one leg") {
+  check_clip("dataset-1_kick", test::shared_clip("dataset-1_kick_normal_001.bvh"));
+}
+TEST_CASE("balance: Bandai Namco punches") {
+  check_clip("dataset-1_punch", test::shared_clip("dataset-1_punch_normal_001.bvh"));
+}
+TEST_CASE("balance: Bandai Namco waving, standing") {
+  check_clip("dataset-2_wave", test::shared_clip("dataset-2_wave-both-hands_normal_001.bvh"));
+}

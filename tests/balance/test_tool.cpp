@@ -1,0 +1,82 @@
+// `tonus zmp` end to end: the report files and their keys, the exit codes,
+// and clear refusals of bad input.
+#include <doctest/doctest.h>
+
+#include <sys/wait.h>
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace {
+
+struct Run {
+  int code = -1;
+  std::string out;
+};
+
+Run run(const std::string& args) {
+  const std::string cmd = std::string(TONUS_TOOL) + " zmp " + args + " 2>&1";
+  Run r;
+  FILE* p = popen(cmd.c_str(), "r");
+  REQUIRE(p != nullptr);
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, p) != nullptr) r.out += buf;
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string temp(const std::string& name) { return std::string(TONUS_TEST_TMP) + "/" + name; }
+
+}  // namespace
+
+TEST_CASE("tonus zmp: corrects the bundled walk and writes BVH, CSV, JSON and SVG") {
+  const std::string clip = std::string(TONUS_SOURCE_DIR) + "/tests/data/cmu_02_walk.bvh";
+  const Run r = run(clip + " -o " + temp("walk.bvh") + " --csv " + temp("walk.csv") + " --json " + temp("walk.json") +
+                    " --svg " + temp("walk.svg"));
+  INFO(r.out);
+  CHECK(r.code == 0);
+  CHECK(r.out.find("before: ZMP outside") != std::string::npos);
+  CHECK(r.out.find("T-pose") != std::string::npos);
+  const std::string json = slurp(temp("walk.json"));
+  for (const char* key : {"\"frames\"", "\"frames_outside_before\"", "\"frames_outside_after\": 0,",
+                          "\"max_outside_before_m\"", "\"max_outside_after_m\"", "\"max_foot_displacement_m\"",
+                          "\"rms_joint_change_rad\"", "\"frames_unsolved\": 0,", "\"frames_airborne\""}) {
+    CHECK_MESSAGE(json.find(key) != std::string::npos, key);
+  }
+  const std::string csv = slurp(temp("walk.csv"));
+  CHECK(csv.rfind("frame,time_s,", 0) == 0);
+  CHECK(std::count(csv.begin(), csv.end(), '\n') == 345);  // header + 344 frames
+  const std::string svg = slurp(temp("walk.svg"));
+  CHECK(svg.find("<svg") == 0);
+  CHECK(svg.find("polyline") != std::string::npos);
+  // The written clip reads back and is balanced: analysing it again finds nothing to correct.
+  const Run again = run(temp("walk.bvh") + " --json " + temp("again.json") + " --unit cmu");
+  CHECK(slurp(temp("again.json")).find("\"frames_outside_before\": 0,") != std::string::npos);
+}
+
+TEST_CASE("tonus zmp: bad input is refused with exit code 2 and a reason") {
+  const Run missing = run(temp("no_such_file.bvh"));
+  CHECK(missing.code == 2);
+  { std::ofstream(temp("broken.bvh")) << "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0\n}\n"; }
+  const Run broken = run(temp("broken.bvh"));
+  CHECK(broken.code == 2);
+  CHECK(broken.out.find("broken.bvh:4") != std::string::npos);  // the line
+  const std::string clip = std::string(TONUS_SOURCE_DIR) + "/tests/data/cmu_02_walk.bvh";
+  CHECK(run(clip + " --unit furlong").code == 2);
+  CHECK(run(clip + " --derivative magic").code == 2);
+  { std::ofstream(temp("map.txt")) << "LeftUpperLeg = nothing_like_it\n"; }
+  const Run mapped = run(clip + " --mapping " + temp("map.txt"));
+  CHECK(mapped.code == 2);
+  CHECK(mapped.out.find("nothing_like_it") != std::string::npos);
+}

@@ -1,0 +1,200 @@
+#include "zmp_command.hpp"
+
+#include <fmt/core.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "tonus/host/balance/apply.hpp"
+#include "tonus/host/balance/convert.hpp"
+#include "tonus/host/balance/filter.hpp"
+#include "tonus/host/motion/bvh.hpp"
+#include "zmp_outputs.hpp"
+
+namespace tonus::tools {
+namespace {
+
+// Metres per file unit from the --unit option; nothing for "guess".
+bool parse_unit(const std::string& text, std::optional<double>& out, std::string& error) {
+  if (text.empty()) return true;
+  const struct {
+    const char* name;
+    double metres;
+  } units[] = {{"m", 1.0}, {"cm", 0.01}, {"mm", 0.001}, {"inch", 0.0254}, {"in", 0.0254}, {"cmu", 0.056444}};
+  for (const auto& u : units) {
+    if (text == u.name) {
+      out = u.metres;
+      return true;
+    }
+  }
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || !(v > 0.0) || !std::isfinite(v)) {
+    error = "--unit: expected m, cm, mm, inch, cmu or a positive number of metres per unit, got '" + text + "'";
+    return false;
+  }
+  out = v;
+  return true;
+}
+
+bool parse_method(const std::string& text, derivatives::Method& out) {
+  if (text == "kalman_spline")
+    out = derivatives::Method::kalman_spline;
+  else if (text == "kalman")
+    out = derivatives::Method::kalman;
+  else if (text == "spline")
+    out = derivatives::Method::spline;
+  else if (text == "finite_difference")
+    out = derivatives::Method::finite_difference;
+  else
+    return false;
+  return true;
+}
+
+struct Progress {
+  bool show = false;
+};
+
+void on_progress(int iteration, std::size_t outside, void* user) {
+  if (!static_cast<Progress*>(user)->show) return;
+  fmt::print(stderr, "\r  balancing: iteration {:3d}, {:5d} frames still outside", iteration, outside);
+  std::fflush(stderr);
+}
+
+}  // namespace
+
+int run_zmp_command(const ZmpCommandOptions& opt) {
+  const auto fail = [](const std::string& message) {
+    fmt::print(stderr, "tonus zmp: {}\n", message);
+    return 2;
+  };
+  motion::ReadResult read = motion::read_bvh_file(opt.input);
+  if (!read.ok()) {
+    // (fmt, not string concatenation: GCC 12 sees a false -Wrestrict in "x" + std::string.)
+    const std::string where = read.error->line > 0 ? fmt::format("{}:{}", opt.input, read.error->line) : opt.input;
+    return fail(fmt::format("{}: {}", where, read.error->message));
+  }
+  std::string mapping_text;
+  if (!opt.mapping.empty()) {
+    std::ifstream in(opt.mapping);
+    if (!in) return fail("cannot read the mapping file " + opt.mapping);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    mapping_text = ss.str();
+  }
+  const balance::MapResult mapping = balance::map_skeleton(read.clip, mapping_text);
+  if (!mapping.ok()) return fail(mapping.error);
+  balance::ConvertOptions convert;
+  std::string error;
+  if (!parse_unit(opt.unit, convert.metres_per_unit, error)) return fail(error);
+  convert.exclude_tpose = !opt.keep_tpose;
+  const balance::Conversion conv = balance::convert_motion(read.clip, mapping, convert);
+  if (!conv.ok()) return fail(conv.error);
+
+  balance::FilterOptions fo;
+  balance::AnalysisOptions& ao = fo.analysis;
+  if (!(opt.body_mass_kg > 0.0)) return fail("--mass must be positive");
+  ao.body_mass_kg = opt.body_mass_kg;
+  if (opt.sex != "male" && opt.sex != "female") return fail("--sex: male or female");
+  ao.sex = opt.sex == "male" ? sim::Sex::male : sim::Sex::female;
+  ao.angular_momentum = opt.full_zmp;
+  if (!parse_method(opt.derivative, ao.derivatives.method)) {
+    return fail("--derivative: kalman_spline, kalman, spline or finite_difference");
+  }
+  ao.derivatives.cutoff_hz = opt.cutoff_hz;
+  if (const derivatives::Status s = derivatives::validate(ao.derivatives, conv.motion.dt_s, conv.motion.size()); !s) {
+    return fail("derivatives: " + std::string(derivatives::to_string(s.error)));
+  }
+  ao.contacts.height_on_m = opt.contact_height_m;
+  ao.contacts.height_off_m = 1.6 * opt.contact_height_m;
+  ao.contacts.speed_on_mps = opt.contact_speed_mps;
+  ao.contacts.speed_off_mps = 2.0 * opt.contact_speed_mps;
+  ao.contacts.foot_length_m = opt.foot_length_m;
+  ao.contacts.ground_z_m = opt.ground_height_m;
+  if (opt.correction != "rotation") return fail("--correction: only 'rotation' (the waist rotation) is offered");
+  fo.margin_m = opt.margin_m;
+  fo.max_correction_rad = opt.max_correction_rad;
+  fo.max_iterations = opt.max_iterations;
+
+  if (!opt.quiet) {
+    fmt::print("tonus zmp: {}\n", opt.input);
+    fmt::print("  skeleton: {} ({} joints), {} frames at {:.0f} Hz, unit {}{}\n", mapping.map.convention,
+               read.clip.joints.size(), read.clip.frame_count, 1.0 / read.clip.frame_time_s, conv.unit_name,
+               conv.unit_guessed ? " (guessed)" : "");
+    for (const std::string& m : conv.messages) fmt::print("  note: {}\n", m);
+    for (const auto& w : read.warnings) fmt::print("  warning (line {}): {}\n", w.line, w.message);
+  }
+  Progress progress{!opt.quiet && (isatty(STDERR_FILENO) != 0 || conv.motion.size() > 1000)};
+  const balance::FilterResult result = balance::balance_filter(conv.motion, fo, on_progress, &progress);
+  if (progress.show) fmt::print(stderr, "\n");
+  if (!result.ok()) return fail(result.error);
+
+  balance::AppliedCorrection applied =
+      balance::apply_correction(read.clip, conv.geometry, conv.motion, result.correction);
+  if (!applied.ok()) return fail(applied.error);
+  if (!opt.output.empty()) {
+    std::ofstream out(opt.output, std::ios::binary);
+    out << motion::write_bvh(applied.clip, 6);
+    if (!out) return fail("cannot write " + opt.output);
+  }
+
+  ZmpReport report;
+  report.input = opt.input;
+  report.convention = mapping.map.convention;
+  report.unit = conv.unit_name;
+  report.unit_guessed = conv.unit_guessed;
+  report.tpose_excluded = conv.tpose_excluded;
+  report.frame_time_s = read.clip.frame_time_s;
+  report.frames_total = read.clip.frame_count;
+  report.filter = &result;
+  report.max_foot_displacement_m = applied.max_foot_displacement_m;
+  report.rms_joint_change_rad = applied.rms_joint_change_rad;
+  for (const balance::Vec3& d : result.correction)
+    report.max_correction_rad = std::max(report.max_correction_rad, d.norm());
+  report.lookahead_frames = result.operator_band;
+  report.forward = travel_direction(conv.motion, result.before);
+  if (!opt.csv.empty() && !write_zmp_csv(opt.csv, report, error)) return fail(error);
+  if (!opt.json.empty() && !write_zmp_json(opt.json, report, error)) return fail(error);
+  if (!opt.svg.empty() && !write_zmp_svg(opt.svg, report, error)) return fail(error);
+
+  const balance::AnalysisSummary& b = result.before.summary;
+  const balance::AnalysisSummary& a = result.after.summary;
+  if (!opt.quiet) {
+    std::size_t both = 0, left = 0, right = 0;
+    for (std::size_t t = conv.motion.first_frame; t < conv.motion.size(); ++t) {
+      const auto& c = result.before.contacts.frames[t];
+      if (c[0].any() && c[1].any())
+        ++both;
+      else if (c[0].any())
+        ++left;
+      else if (c[1].any())
+        ++right;
+    }
+    fmt::print("  contacts: {} frames double support, {} left foot only, {} right foot only, {} airborne\n", both, left,
+               right, b.frames_airborne);
+    fmt::print("  before: ZMP outside the support polygon in {} of {} frames (max {:.3f} m, RMS {:.3f} m)\n",
+               b.frames_outside, b.frames, b.max_outside_m, b.rms_outside_m);
+    fmt::print("  after:  ZMP outside the support polygon in {} of {} frames (max {:.3f} m), {} unsolved\n",
+               a.frames_outside, a.frames, a.max_outside_m, result.frames_unsolved);
+    fmt::print(
+        "  correction: waist rotation up to {:.3f} rad, RMS joint change {:.4f} rad, feet moved by at most "
+        "{:.2e} m, {} iterations\n",
+        report.max_correction_rad, report.rms_joint_change_rad, report.max_foot_displacement_m, result.iterations);
+    if (result.frames_unsolved > 0) {
+      std::string list;
+      std::size_t shown = 0;
+      for (std::size_t t = 0; t < result.unsolved.size() && shown < 12; ++t) {
+        if (!result.unsolved[t]) continue;
+        list += (shown++ > 0 ? ", " : "") + std::to_string(t);
+      }
+      fmt::print("  unsolved frames (no correction within {:.2f} rad, or a leg out of reach): {}{}\n",
+                 opt.max_correction_rad, list, result.frames_unsolved > shown ? ", ..." : "");
+    }
+    if (!opt.output.empty()) fmt::print("  written: {}\n", opt.output);
+  }
+  return result.frames_unsolved == 0 ? 0 : 1;
+}
+
+}  // namespace tonus::tools

@@ -1,0 +1,42 @@
+// `tonus zmp IN.bvh -o OUT.bvh`: the ZMP balance filter as a tool. Reads a
+// clip, analyses its zero moment point against the feet's support polygon,
+// corrects the waist rotation where the ZMP leaves it, writes the corrected
+// clip, and reports before and after (text; optionally CSV per frame, a JSON
+// report and an SVG plot).
+#pragma once
+
+#include <optional>
+#include <string>
+
+namespace tonus::tools {
+
+struct ZmpCommandOptions {
+  std::string input;
+  std::string output;   // corrected BVH (empty: analysis only)
+  std::string csv;      // per-frame ZMP before/after
+  std::string json;     // machine-readable report
+  std::string svg;      // plot of the ZMP trajectories
+  std::string mapping;  // a mapping file overriding the skeleton's joint names
+  std::string unit;     // m, cm, mm, inch, cmu, or metres per unit; empty: guess
+  double body_mass_kg = 70.0;
+  std::string sex = "male";
+  std::optional<double> foot_length_m;
+  std::optional<double> ground_height_m;
+  double contact_height_m = 0.025;
+  double contact_speed_mps = 0.30;
+  std::string derivative = "kalman_spline";  // kalman_spline, kalman, spline, finite_difference
+  double cutoff_hz = 6.0;
+  bool full_zmp = false;                // include the segments' angular momentum rate
+  std::string correction = "rotation";  // the only method: waist rotation
+  double margin_m = 0.01;
+  double max_correction_rad = 1.0;
+  int max_iterations = 100;
+  bool keep_tpose = false;
+  bool quiet = false;
+};
+
+// Process exit code: 0 when every analysed frame ends inside its support
+// polygon (or airborne), 1 when frames remain unsolved, 2 on bad input.
+int run_zmp_command(const ZmpCommandOptions& options);
+
+}  // namespace tonus::tools

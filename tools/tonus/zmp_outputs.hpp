@@ -1,0 +1,34 @@
+// The balance report's files: CSV per frame, a JSON report, an SVG plot.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "tonus/host/balance/filter.hpp"
+
+namespace tonus::tools {
+
+struct ZmpReport {
+  std::string input;
+  std::string convention;
+  std::string unit;
+  bool unit_guessed = false;
+  bool tpose_excluded = false;
+  double frame_time_s = 0.0;
+  std::size_t frames_total = 0;
+  const balance::FilterResult* filter = nullptr;
+  double max_foot_displacement_m = 0.0;  // measured on the written clip
+  double rms_joint_change_rad = 0.0;
+  double max_correction_rad = 0.0;
+  std::size_t lookahead_frames = 0;
+  balance::Vec2 forward = balance::Vec2::UnitX();  // the plots' forward axis in the ground plane
+};
+
+// The direction the motion travels (or, in place, the way the body faces at the start).
+balance::Vec2 travel_direction(const balance::HumanMotion& motion, const balance::Analysis& analysis);
+
+bool write_zmp_csv(const std::string& path, const ZmpReport& r, std::string& error);
+bool write_zmp_json(const std::string& path, const ZmpReport& r, std::string& error);
+bool write_zmp_svg(const std::string& path, const ZmpReport& r, std::string& error);
+
+}  // namespace tonus::tools
