@@ -1,0 +1,70 @@
+// Throughput of the ZMP analysis and of the balance filter, in frames per
+// second, on the bundled CMU walk (120 Hz) and the Bandai Namco walk (30 Hz)
+// when ../shared/data is there.
+#include <benchmark/benchmark.h>
+
+#include <string>
+
+#include "tonus/host/balance/analysis.hpp"
+#include "tonus/host/balance/convert.hpp"
+#include "tonus/host/balance/filter.hpp"
+#include "tonus/host/motion/bvh.hpp"
+
+namespace {
+
+using namespace tonus;
+
+balance::HumanMotion load(const std::string& path, bool& ok) {
+  const motion::ReadResult r = motion::read_bvh_file(path);
+  ok = r.ok();
+  if (!ok) return {};
+  const balance::Conversion c = balance::convert_motion(r.clip, balance::map_skeleton(r.clip), {});
+  ok = c.ok();
+  return c.motion;
+}
+
+void analyse(benchmark::State& state, const std::string& path) {
+  bool ok = false;
+  const balance::HumanMotion m = load(path, ok);
+  if (!ok) {
+    state.SkipWithError("clip not readable");
+    return;
+  }
+  for (auto _ : state) {  // NOLINT(clang-analyzer-deadcode.DeadStores): Google Benchmark's loop idiom
+    benchmark::DoNotOptimize(balance::analyse(m, balance::AnalysisOptions{}));
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(m.size()));
+  state.counters["frames"] = static_cast<double>(m.size());
+}
+
+void filter(benchmark::State& state, const std::string& path) {
+  bool ok = false;
+  const balance::HumanMotion m = load(path, ok);
+  if (!ok) {
+    state.SkipWithError("clip not readable");
+    return;
+  }
+  std::size_t band = 0, iterations = 0;
+  for (auto _ : state) {  // NOLINT(clang-analyzer-deadcode.DeadStores): Google Benchmark's loop idiom
+    const balance::FilterResult f = balance::balance_filter(m, balance::FilterOptions{});
+    band = f.operator_band;
+    iterations = static_cast<std::size_t>(f.iterations);
+    benchmark::DoNotOptimize(f.correction.data());
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(m.size()));
+  state.counters["frames"] = static_cast<double>(m.size());
+  state.counters["lookahead_frames"] = static_cast<double>(band);
+  state.counters["solver_iterations"] = static_cast<double>(iterations);
+}
+
+const std::string kCmuWalk = std::string(TONUS_SOURCE_DIR) + "/tests/data/cmu_02_walk.bvh";
+const std::string kBandaiWalk = std::string(TONUS_SHARED_DATA_DIR) + "/bvh/dataset-1_walk_normal_001.bvh";
+
+}  // namespace
+
+BENCHMARK_CAPTURE(analyse, cmu_walk_120hz, kCmuWalk)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(analyse, bandai_walk_30hz, kBandaiWalk)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(filter, cmu_walk_120hz, kCmuWalk)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(filter, bandai_walk_30hz, kBandaiWalk)->Unit(benchmark::kMillisecond);
+
+BENCHMARK_MAIN();
