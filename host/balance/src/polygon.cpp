@@ -90,12 +90,14 @@ Vec2 nearest_point(const ConvexPolygon& poly, const Vec2& p) {
 }
 
 Vec2 nearest_point_inset(const ConvexPolygon& poly, const Vec2& p, double inset) {
-  const Vec2 q = nearest_point(poly, p);
+  Vec2 q = nearest_point(poly, p);
   if (poly.vertices.size() < 3 || inset <= 0.0 || q == p) return q;
-  // Step inwards from q along the outward normal, reversed, as far as `inset` stays inside.
+  // Step inwards from q along the outward normal, reversed, halving the
+  // depth until the point is that deep inside (a thin polygon allows less).
   const Vec2 n = (p - q).normalized();
-  for (double d = inset; d > 1e-6; d *= 0.5) {
-    const Vec2 c = q - d * n;
+  double d = inset;
+  for (int halving = 0; halving < 20; ++halving, d *= 0.5) {
+    Vec2 c = q - d * n;
     if (signed_distance(poly, c) <= -0.999 * d) return c;
   }
   return q;
