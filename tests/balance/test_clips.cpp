@@ -42,8 +42,11 @@ void check_clip(const std::string& name, const std::string& path) {
   CHECK(reread.summary.frames_outside == 0);
   CHECK(applied.max_foot_displacement_m < 1e-3);
   CHECK(f.max_foot_displacement_m < 1e-3);
-  // Airborne frames are counted apart, never as outside.
+  // Airborne frames are counted apart, never as outside, and left uncorrected.
   CHECK(f.after.summary.frames_airborne == f.before.summary.frames_airborne);
+  for (std::size_t t = 0; t < f.before.frames.size(); ++t) {
+    if (f.before.frames[t].analysed && f.before.frames[t].airborne) CHECK(f.correction[t].norm() == 0.0);
+  }
 }
 
 }  // namespace

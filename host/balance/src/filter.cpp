@@ -261,12 +261,28 @@ FilterResult balance_filter(const HumanMotion& motion, const FilterOptions& o, F
     for (int attempt = 0; attempt < 8 && !accepted; ++attempt) {
       Eigen::SparseMatrix<double> damped = hess;
       for (Eigen::Index i = 0; i < unknowns; ++i) damped.coeffRef(i, i) += damping * (1.0 + hess.coeff(i, i));
+      // Airborne frames are left uncorrected: their unknowns are pinned at zero
+      // (a turn in flight would bend the ballistic path of the centre of mass).
+      Eigen::VectorXd b = rhs;
+      std::vector<bool> pinned(static_cast<std::size_t>(unknowns), false);
+      for (std::size_t k = 0; k < m; ++k) {
+        if (!r.before.frames[first + k].airborne) continue;
+        for (std::size_t e = 0; e < 3; ++e) pinned[3 * k + e] = true;
+      }
+      damped.prune([&pinned](Eigen::Index i, Eigen::Index j, double) {
+        return i == j || (!pinned[static_cast<std::size_t>(i)] && !pinned[static_cast<std::size_t>(j)]);
+      });
+      for (Eigen::Index i = 0; i < unknowns; ++i) {
+        if (!pinned[static_cast<std::size_t>(i)]) continue;
+        damped.coeffRef(i, i) = 1.0;
+        b(i) = 0.0;
+      }
       Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(damped);
       if (solver.info() != Eigen::Success) {
         damping *= 10.0;
         continue;
       }
-      const Eigen::VectorXd step = solver.solve(rhs);
+      const Eigen::VectorXd step = solver.solve(b);
       std::vector<Vec3> trial = r.correction;
       for (std::size_t k = 0; k < m; ++k) {
         Vec3 d = trial[first + k] + step.segment<3>(static_cast<Eigen::Index>(3 * k));
