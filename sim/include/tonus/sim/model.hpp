@@ -124,7 +124,7 @@ struct Features {
 
 struct SolverOptions {
   int iterations = 60;               // projected Gauss-Seidel sweeps, at most
-  double tolerance = 1e-6;           // stop when no row's velocity moves by more than this in a sweep (m/s, rad/s)
+  double tolerance = 1e-5;           // stop when no row's velocity moves by more than this in a sweep (m/s, rad/s)
   double baumgarte = 0.2;            // fraction of a penetration corrected per step
   double penetration_slop_m = 5e-4;  // penetration left alone (keeps resting contacts quiet)
   double contact_margin_m = 0.01;    // speculative distance, plus what the shapes sweep in one step
