@@ -85,8 +85,8 @@ void BM_DualTick(benchmark::State& state) {
   set_root_mode(*a, RootMode::kinematic);
   StepInputs in_a = make_inputs(m);
   for (int i = 0; i < m.nbody; ++i) {
-    in_a.kp[static_cast<std::size_t>(i)] *= 10.0;
-    b.inputs.kp[static_cast<std::size_t>(i)] *= 0.1;
+    scale_joint_gains(m, in_a, i, 10.0, 1.0);
+    scale_joint_gains(m, b.inputs, i, 0.1, 1.0);
   }
   for (auto _ : state) {  // NOLINT(clang-analyzer-deadcode.DeadStores): Google Benchmark's loop idiom
     step(m, *a, in_a);

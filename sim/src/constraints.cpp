@@ -14,6 +14,7 @@
 #include "ltdl.hpp"
 #include "spatial.hpp"
 #include "stages.hpp"
+#include "tonus/sim/joint_limits.hpp"
 
 namespace tonus::sim::detail {
 namespace {
@@ -37,28 +38,6 @@ bool add_row(Data& data, const Row& r) {
   if (data.nrows >= static_cast<int>(kMaxRows)) return false;
   data.rows[static_cast<size_t>(data.nrows++)] = r;
   return true;
-}
-
-// Swing-twist decomposition about the body-frame twist axis t: the swing
-// angle, the swing axis (parent-rest frame) and the twist angle.
-struct SwingTwist {
-  double swing;
-  Vec3 swing_axis;
-  double twist;
-};
-SwingTwist swing_twist(const Quat& q_in, const Vec3& t) {
-  Quat q = q_in.normalized();
-  if (q.w() < 0.0) q.coeffs() = -q.coeffs();
-  const Vec3 u = q * t;
-  const Vec3 c = t.cross(u);
-  const double s = c.norm();
-  SwingTwist st{};
-  st.swing = std::atan2(s, t.dot(u));
-  st.swing_axis = s > 1e-12 ? Vec3(c / s) : Vec3::Zero();
-  st.twist = 2.0 * std::atan2(q.vec().dot(t), q.w());
-  if (st.twist > M_PI) st.twist -= 2.0 * M_PI;
-  if (st.twist < -M_PI) st.twist += 2.0 * M_PI;
-  return st;
 }
 
 void limit_row(const Model& model, Data& data, int body, const Vec3& coef, double dist) {
@@ -103,16 +82,16 @@ void build_limit_rows(const Model& model, Data& data) {
       const Vec3& t = b.limit.twist_axis;
       const SwingTwist st = swing_twist(q, t);
       const double reach = margin + w.norm() * dt;
-      if (b.limit.swing_max_rad - st.swing < reach && st.swing_axis.squaredNorm() > 0.0) {
+      if (b.limit.swing_max_rad - st.swing_rad < reach && st.swing_axis.squaredNorm() > 0.0) {
         // d(swing)/dt = axis . (R(q) w): the row is -(R(q)^T axis).
         const Vec3 coef = -(q.normalized().toRotationMatrix().transpose() * st.swing_axis);
-        limit_row(model, data, static_cast<int>(i), coef, b.limit.swing_max_rad - st.swing);
+        limit_row(model, data, static_cast<int>(i), coef, b.limit.swing_max_rad - st.swing_rad);
       }
       // Twist rate taken as the spin about the body's own axis (exact without swing).
-      if (st.twist - b.limit.lower_rad < reach)
-        limit_row(model, data, static_cast<int>(i), t, st.twist - b.limit.lower_rad);
-      if (b.limit.upper_rad - st.twist < reach)
-        limit_row(model, data, static_cast<int>(i), -t, b.limit.upper_rad - st.twist);
+      if (st.twist_rad - b.limit.lower_rad < reach)
+        limit_row(model, data, static_cast<int>(i), t, st.twist_rad - b.limit.lower_rad);
+      if (b.limit.upper_rad - st.twist_rad < reach)
+        limit_row(model, data, static_cast<int>(i), -t, b.limit.upper_rad - st.twist_rad);
     }
   }
 }

@@ -141,18 +141,19 @@ bool adjacent(const Model& model, int b1, int b2) {
 
 void detect_contacts(const Model& model, Data& data) {
   data.ncon = 0;
-  if (!model.features.contacts) return;
+  if (!model.features.contacts || !data.collisions.contacts) return;
   Collector collect(model, data);
   static const Shape kPlane = Shape::plane();
   const Candidate ground{&kPlane, ground_pose(model.ground), {}, model.ground.material, 0.0};
-  const bool with_ground = model.ground.enabled;
+  const bool with_ground = model.ground.enabled && data.collisions.ground;
+  const bool with_objects = data.collisions.objects;
   const auto ngeom = static_cast<size_t>(model.ngeom);
 
   for (size_t g = 0; g < ngeom; ++g) {
     const Geom& geom = model.geoms[g];
     const Candidate body = body_candidate(model, data, g);
     if (with_ground && geom.collides_with_ground) collect.pair(body, ground);
-    if (geom.collides_with_objects) {
+    if (with_objects && geom.collides_with_objects) {
       for (size_t i = 0; i < kMaxObjects; ++i) {
         if (data.objects[i].active) collect.pair(object_candidate(model, data, i), body);
       }

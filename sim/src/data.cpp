@@ -33,6 +33,8 @@ void reset_data(const Model& model, Data& data) {
   data.status = StepStatus::ok;
   data.root_servo_force.setZero();
   data.root_servo_torque.setZero();
+  data.root_wrench_force.setZero();
+  data.root_wrench_torque.setZero();
   forward_kinematics(model, data);
 }
 

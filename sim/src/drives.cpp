@@ -43,10 +43,12 @@ bool root_is_free_joint(const Model& model) { return model.bodies[0].joint == Jo
 int read_inputs(const Model& model, Data& data, const StepInputs& in) {
   int bad = 0;
   const auto nbody = static_cast<size_t>(model.nbody);
-  for (size_t i = 0; i < nbody; ++i) {
-    data.drive_kp[i] = gain_or_zero(in.kp[i], bad);
-    data.drive_kd[i] = gain_or_zero(in.kd[i], bad);
-    data.drive_limit[i] = gain_or_zero(in.torque_limit_nm[i], bad);
+  for (size_t i = 0; i < nbody; ++i) data.drive_limit[i] = gain_or_zero(in.torque_limit_nm[i], bad);
+  // Root dofs carry no drive (the root servo has its own gains).
+  const size_t first_joint_dof = root_is_free_joint(model) ? 6 : 0;
+  for (size_t d = 0; d < static_cast<size_t>(model.nv); ++d) {
+    data.drive_kp[d] = d < first_joint_dof ? 0.0 : gain_or_zero(in.kp[d], bad);
+    data.drive_kd[d] = d < first_joint_dof ? 0.0 : gain_or_zero(in.kd[d], bad);
   }
   for (size_t d = 0; d < static_cast<size_t>(model.nv); ++d) {
     const double t = in.tau_ff[d];
@@ -94,8 +96,7 @@ void drive_errors(const Model& model, Data& data, const StepInputs& in) {
     const auto d0 = static_cast<size_t>(b.dof_adr);
     const auto q0 = static_cast<size_t>(b.qpos_adr);
     Vec3 err = Vec3::Zero();
-    double kp = data.drive_kp[i];
-    const double kd = data.drive_kd[i];
+    bool has_target = true;
     switch (b.joint) {
       case JointType::hinge: {
         const double target = in.target_qpos[q0];
@@ -109,7 +110,7 @@ void drive_errors(const Model& model, Data& data, const StepInputs& in) {
           target.coeffs() /= n;
           err = quat_log(target.conjugate() * read_quat(data.qpos, b.qpos_adr).normalized());
         } else {
-          kp = 0.0;  // no usable target: the drive only damps
+          has_target = false;  // no usable target: the drive only damps
         }
         break;
       }
@@ -142,8 +143,8 @@ void drive_errors(const Model& model, Data& data, const StepInputs& in) {
     for (size_t k = 0; k < static_cast<size_t>(b.dof_num); ++k) {
       const size_t d = d0 + k;
       const double vref = in.target_qvel[d];
-      data.law_kp[d] = kp;
-      data.law_kd[d] = kd;
+      data.law_kp[d] = has_target ? data.drive_kp[d] : 0.0;
+      data.law_kd[d] = data.drive_kd[d];
       data.err_dof[d] = err(static_cast<Eigen::Index>(k));
       data.vref_dof[d] = finite(vref) ? vref : 0.0;
     }
@@ -192,10 +193,13 @@ void add_drive_rows(const Model& model, Data& data) {
     if (!data.drive_in_rows[i]) continue;
     const Body& b = model.bodies[i];
     const auto d0 = static_cast<size_t>(b.dof_adr);
-    const double stiffness = data.law_kd[d0] + dt * data.law_kp[d0];  // K' of the law, per dof
+    // K' of the law per dof (a ball joint's axes may differ); every axis needs one.
+    bool compliant = true;
+    for (size_t d = d0; d < d0 + static_cast<size_t>(b.dof_num); ++d)
+      compliant = compliant && data.law_kd[d] + dt * data.law_kp[d] > 0.0;
     const bool fits = data.nrows + b.dof_num <= static_cast<int>(kMaxRows) &&
                       data.njoint_rows + b.dof_num <= static_cast<int>(kMaxJointRows);
-    if (!(stiffness > 0.0) || !fits) {
+    if (!compliant || !fits) {
       // A constant feedforward alone, or no room: back to the inertia (unclamped, counted if for room).
       if (!fits) ++data.diag.limit_overflow;
       data.drive_in_rows[i] = false;
@@ -209,14 +213,15 @@ void add_drive_rows(const Model& model, Data& data) {
     const int group = data.nrows;
     for (int k = 0; k < b.dof_num; ++k) {
       const size_t d = d0 + static_cast<size_t>(k);
+      const double k_dof = data.law_kd[d] + dt * data.law_kp[d];
       Data::Row r;
       r.kind = Data::Row::Kind::drive;
       r.limit_body = static_cast<int>(i);
       r.limit_coef = Vec3::Unit(k);
       r.support = model.body_path_dofs[i];
       // tau = -K' (v+ - v*): the law rearranged around its velocity target.
-      r.target = (data.law_kd[d] * data.vref_dof[d] - data.law_kp[d] * data.err_dof[d] + data.drive_ff[d]) / stiffness;
-      r.cfm = 1.0 / (dt * stiffness);
+      r.target = (data.law_kd[d] * data.vref_dof[d] - data.law_kp[d] * data.err_dof[d] + data.drive_ff[d]) / k_dof;
+      r.cfm = 1.0 / (dt * k_dof);
       r.bound = data.drive_limit[i] * dt;
       r.group = group;
       r.lambda = data.drive_impulse[d];

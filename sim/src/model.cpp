@@ -21,10 +21,10 @@ int Model::body_index(std::string_view n) const {
 StepInputs make_inputs(const Model& model) {
   StepInputs in;
   in.target_qpos = model.qpos0;
+  in.kp = model.dof_kp;
+  in.kd = model.dof_kd;
   for (int i = 0; i < model.nbody; ++i) {
     const auto b = static_cast<std::size_t>(i);
-    in.kp[b] = model.bodies[b].drive.kp;
-    in.kd[b] = model.bodies[b].drive.kd;
     in.torque_limit_nm[b] = model.bodies[b].drive.torque_limit_nm;
   }
   const Body& root = model.bodies[0];
@@ -36,6 +36,24 @@ StepInputs make_inputs(const Model& model) {
     in.root_quat = root.quat_in_parent;
   }
   return in;
+}
+
+void set_joint_gains(const Model& model, StepInputs& in, int body, double kp, double kd) {
+  if (body < 0 || body >= model.nbody) return;
+  const Body& b = model.bodies[static_cast<std::size_t>(body)];
+  for (int k = b.dof_adr; k < b.dof_adr + b.dof_num; ++k) {
+    in.kp[static_cast<std::size_t>(k)] = kp;
+    in.kd[static_cast<std::size_t>(k)] = kd;
+  }
+}
+
+void scale_joint_gains(const Model& model, StepInputs& in, int body, double kp_factor, double kd_factor) {
+  if (body < 0 || body >= model.nbody) return;
+  const Body& b = model.bodies[static_cast<std::size_t>(body)];
+  for (int k = b.dof_adr; k < b.dof_adr + b.dof_num; ++k) {
+    in.kp[static_cast<std::size_t>(k)] *= kp_factor;
+    in.kd[static_cast<std::size_t>(k)] *= kd_factor;
+  }
 }
 
 }  // namespace tonus::sim

@@ -135,6 +135,45 @@ void report_root_servo(const Model& model, Data& data) {
   data.root_servo_torque = r * Vec3(data.tau_pd[3], data.tau_pd[4], data.tau_pd[5]);
 }
 
+// The wrench the world applies to a prescribed (kinematic or fixed) root over the step: the root
+// rows of M a + c + g minus the contacts' generalized impulse on them (joint
+// drives and limits act on their own joint's dofs only). Evaluated at the
+// start-of-step kinematics the step used.
+void report_kinematic_root_wrench(const Model& model, Data& data) {
+  const double dt = model.timestep_s;
+  const auto nv = static_cast<size_t>(model.nv);
+  std::array<double, 6> f{};
+  for (size_t p = 0; p < 6; ++p) {
+    double s = data.bias[p];
+    for (size_t j = 0; j <= p; ++j) s += data.mass[p * nv + j] * (data.qvel_next[j] - data.qvel[j]) / dt;
+    for (size_t k = p + 1; k < nv; ++k) s += data.mass[k * nv + p] * (data.qvel_next[k] - data.qvel[k]) / dt;
+    f[p] = s;
+  }
+  for (int r = 0; r < data.nrows; ++r) {
+    const Data::Row& row = data.rows[static_cast<size_t>(r)];
+    if (row.kind == Data::Row::Kind::limit || row.kind == Data::Row::Kind::drive || row.lambda == 0.0) continue;
+    for (const auto* side : {&row.a, &row.b}) {
+      if (side->kind != ContactSide::Kind::body) continue;
+      const Vec6& u = side == &row.a ? row.ua : row.ub;
+      for (size_t p = 0; p < 6; ++p) f[p] -= u.dot(data.cdof[p]) * row.lambda / dt;
+    }
+  }
+  data.root_wrench_force = Vec3(f[0], f[1], f[2]);
+  data.root_wrench_torque = data.xbody[0].rot * Vec3(f[3], f[4], f[5]);
+}
+
+void report_root_wrench(const Model& model, Data& data) {
+  data.root_wrench_force.setZero();
+  data.root_wrench_torque.setZero();
+  if (model.bodies[0].joint != JointType::free) return;
+  if (data.root_mode != RootMode::free) {  // kinematic or fixed: prescribed
+    report_kinematic_root_wrench(model, data);
+  } else if (data.root_mode == RootMode::free) {
+    data.root_wrench_force = data.root_servo_force;
+    data.root_wrench_torque = data.root_servo_torque;
+  }
+}
+
 // The real-time step: semi-implicit Euler with implicit drives and constraints.
 bool step_euler(const Model& model, Data& data, const StepInputs& inputs) {
   forward_kinematics(model, data);
@@ -167,6 +206,7 @@ bool step_euler(const Model& model, Data& data, const StepInputs& inputs) {
   if (!ok) return false;
   detail::release_drive_rows(model, data);
   report_root_servo(model, data);
+  report_root_wrench(model, data);
   detail::integrate(model, data, inputs);
   detail::report_contacts(model, data);
   return true;

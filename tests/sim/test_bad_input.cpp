@@ -201,8 +201,10 @@ TEST_CASE("non-finite or absurd step inputs are replaced by safe values, counted
          for (std::size_t k = 0; k < 4; ++k)
            in.target_qpos[static_cast<std::size_t>(m.bodies[shoulder].qpos_adr) + k] = 0.0;
        }},
-      {"NaN kp", [&](const Model&, StepInputs& in) { in.kp[elbow] = kNaN; }},
-      {"negative kd", [&](const Model&, StepInputs& in) { in.kd[elbow] = -3.0; }},
+      {"NaN kp",
+       [&](const Model& m, StepInputs& in) { in.kp[static_cast<std::size_t>(m.bodies[elbow].dof_adr)] = kNaN; }},
+      {"negative kd",
+       [&](const Model& m, StepInputs& in) { in.kd[static_cast<std::size_t>(m.bodies[elbow].dof_adr)] = -3.0; }},
       {"infinite torque limit", [&](const Model&, StepInputs& in) { in.torque_limit_nm[elbow] = INFINITY; }},
       {"NaN feedforward",
        [&](const Model& m, StepInputs& in) { in.tau_ff[static_cast<std::size_t>(m.bodies[elbow].dof_adr)] = kNaN; }},
@@ -239,7 +241,7 @@ TEST_CASE("non-finite or absurd step inputs are replaced by safe values, counted
   // Counted where a value was replaced.
   auto data = make_data(*model);
   StepInputs in = make_inputs(*model);
-  in.kp[elbow] = kNaN;
+  in.kp[static_cast<std::size_t>(model->bodies[elbow].dof_adr)] = kNaN;
   CHECK(step(*model, *data, in) == StepStatus::sanitized);
   CHECK(data->diag.bad_inputs == 1);
 

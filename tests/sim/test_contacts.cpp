@@ -166,8 +166,7 @@ TEST_CASE("a 1 kg cube resting on an open hand held by its drives: normal force 
   set_root_mode(*data, RootMode::fixed);
   StepInputs in = make_inputs(*model);
   for (int i = 1; i < model->nbody; ++i) {
-    in.kp[static_cast<std::size_t>(i)] *= 25.0;  // a firm hold: 20 Hz instead of the default 4 Hz
-    in.kd[static_cast<std::size_t>(i)] *= 5.0;
+    scale_joint_gains(*model, in, i, 25.0, 5.0);  // a firm hold: 20 Hz instead of the default 4 Hz
     in.torque_limit_nm[static_cast<std::size_t>(i)] = 0.0;
   }
   // Gravity feedforward of the arm at rest (the dual scheme's simulation A provides it in tonus).
@@ -208,8 +207,7 @@ TEST_CASE("the humanoid standing on its feet: the ground carries its weight") {
   auto data = make_data(*model);
   StepInputs in = make_inputs(*model);
   for (int i = 1; i < model->nbody; ++i) {
-    in.kp[static_cast<std::size_t>(i)] *= 100.0;  // a statue: 40 Hz
-    in.kd[static_cast<std::size_t>(i)] *= 10.0;
+    scale_joint_gains(*model, in, i, 100.0, 10.0);  // a statue: 40 Hz
     in.torque_limit_nm[static_cast<std::size_t>(i)] = 0.0;
   }
   for (int s = 0; s < 2000; ++s) REQUIRE(step(*model, *data, in) == StepStatus::ok);

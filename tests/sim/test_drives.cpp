@@ -38,8 +38,7 @@ void set_gains(const Model& m, Data& d, StepInputs& in, double kp, double zeta) 
       inertia = std::max(
           inertia, d.mass[static_cast<std::size_t>(k) * static_cast<std::size_t>(m.nv) + static_cast<std::size_t>(k)]);
     }
-    in.kp[static_cast<std::size_t>(i)] = kp;
-    in.kd[static_cast<std::size_t>(i)] = zeta * 2.0 * std::sqrt(kp * inertia);
+    set_joint_gains(m, in, i, kp, zeta * 2.0 * std::sqrt(kp * inertia));
     in.torque_limit_nm[static_cast<std::size_t>(i)] = 0.0;
   }
 }
@@ -167,12 +166,10 @@ TEST_CASE("a drive over its torque limit is clamped to it, and the clamp is what
   StepInputs in = make_inputs(*model);
   const auto elbow = index(Bone::RightLowerArm);
   const auto shoulder = index(Bone::RightUpperArm);
-  in.kp[elbow] = 1e4;
-  in.kd[elbow] = 50.0;
+  set_joint_gains(*model, in, static_cast<int>(elbow), 1e4, 50.0);
   in.torque_limit_nm[elbow] = 5.0;
   in.target_qpos[static_cast<std::size_t>(model->bodies[elbow].qpos_adr)] = 2.0;
-  in.kp[shoulder] = 1e4;
-  in.kd[shoulder] = 100.0;
+  set_joint_gains(*model, in, static_cast<int>(shoulder), 1e4, 100.0);
   in.torque_limit_nm[shoulder] = 12.0;
   const Quat lift = quat_exp(Vec3(1.2, 0, 0));
   const auto sq = static_cast<std::size_t>(model->bodies[shoulder].qpos_adr);

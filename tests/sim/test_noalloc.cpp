@@ -22,8 +22,7 @@ TEST_CASE("10,000 steps with contacts, drives and objects added and removed allo
   auto data = make_data(model);
   StepInputs in = make_inputs(model);
   for (int i = 1; i < model.nbody; ++i) {
-    in.kp[static_cast<std::size_t>(i)] *= 100.0;
-    in.kd[static_cast<std::size_t>(i)] *= 10.0;
+    scale_joint_gains(model, in, i, 100.0, 10.0);
   }
   ObjectSpec ball;
   ball.shape = Shape::sphere(0.05);

@@ -87,10 +87,20 @@ enum class StepStatus : std::uint8_t {
   diverged,   // the state was about to become non-finite or explode: restored, caller should reset
 };
 
+// What this instance collides with, on top of the Model's features and
+// ground: simulation A of the dual scheme runs without contacts (or with the
+// ground only) from the same Model as simulation B.
+struct CollisionSwitches {
+  bool contacts = true;  // false: no contacts at all for this Data
+  bool ground = true;    // false: nothing touches the ground plane
+  bool objects = true;   // false: objects do not touch the articulation (they still meet the ground and each other)
+};
+
 struct Data {
   // ---- state -------------------------------------------------------------
   double time_s = 0.0;
   RootMode root_mode = RootMode::free;
+  CollisionSwitches collisions;
   std::array<double, kMaxQpos> qpos{};
   std::array<double, kMaxDofs> qvel{};
   std::array<Object, kMaxObjects> objects{};
@@ -102,6 +112,13 @@ struct Data {
   std::array<bool, kMaxBodies> drive_saturated{};  // the drive's torque sat on its limit
   Vec3 root_servo_force = Vec3::Zero();            // world, N
   Vec3 root_servo_torque = Vec3::Zero();           // world, N*m
+  // The wrench the world applies to the root to move it as it moved: a
+  // kinematic root's absorbed wrench (what holds the hips on the reference),
+  // a free root's servo wrench, zero for a free root without servo. Force in
+  // the world frame (N), torque in world axes about the root's origin (N*m),
+  // averaged over the step.
+  Vec3 root_wrench_force = Vec3::Zero();
+  Vec3 root_wrench_torque = Vec3::Zero();
   std::array<Contact, kMaxContacts> contacts{};
   int ncon = 0;
   Diagnostics diag;
@@ -123,8 +140,8 @@ struct Data {
   std::array<double, kMaxDofs * kMaxDofs> mass{};    // joint-space inertia, lower triangle, row stride nv
   std::array<double, kMaxDofs * kMaxDofs> factor{};  // M + dt*Kd + dt^2*Kp, factored in place (LTDL)
   std::array<double, kMaxDofs> bias{};               // C(q, v) + gravity
-  std::array<double, kMaxBodies> drive_kp{};         // the inputs, checked (bad values replaced)
-  std::array<double, kMaxBodies> drive_kd{};
+  std::array<double, kMaxDofs> drive_kp{};           // the inputs, checked (bad values replaced)
+  std::array<double, kMaxDofs> drive_kd{};
   std::array<double, kMaxBodies> drive_limit{};
   std::array<double, kMaxDofs> drive_ff{};
   // Drives that reached their torque limit are solved as bounded rows (see

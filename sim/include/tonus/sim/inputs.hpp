@@ -42,9 +42,12 @@ struct StepInputs {
   // Feedforward generalized force per dof, N*m (root dofs: an external
   // force, world frame, and torque, body frame, on the root).
   std::array<double, kMaxDofs> tau_ff{};
-  // Per body (joint): gains and torque limit (0 = unlimited).
-  std::array<double, kMaxBodies> kp{};
-  std::array<double, kMaxBodies> kd{};
+  // Gains per dof, indexed as qvel and tau_ff (a ball joint may have a gain
+  // per body-frame axis; root entries unused), N*m/rad and N*m*s/rad.
+  std::array<double, kMaxDofs> kp{};
+  std::array<double, kMaxDofs> kd{};
+  // Torque limit per body (joint), on the norm of the joint's PD + feedforward
+  // torque (0 = unlimited).
   std::array<double, kMaxBodies> torque_limit_nm{};
 
   // Root reference at the end of the step: imposed in kinematic mode, the
@@ -60,5 +63,10 @@ struct StepInputs {
 // Inputs that hold the model's rest pose with its default gains, the root
 // reference at the model's rest root pose.
 StepInputs make_inputs(const Model& model);
+
+// The same gains on every dof of a body's joint (a per-joint shorthand).
+void set_joint_gains(const Model& model, StepInputs& in, int body, double kp, double kd);
+// Every dof of a body's joint scaled by these factors.
+void scale_joint_gains(const Model& model, StepInputs& in, int body, double kp_factor, double kd_factor);
 
 }  // namespace tonus::sim
