@@ -3,6 +3,7 @@
 
 #include <exception>
 
+#include "experiment_command.hpp"
 #include "physics_demo.hpp"
 #include "protocol_demo.hpp"
 #include "zmp_command.hpp"
@@ -74,7 +75,23 @@ int run(int argc, char** argv) {
   zmp_cmd->add_flag("--keep-tpose", zmp.keep_tpose, "Analyse a leading T-pose frame too");
   zmp_cmd->add_flag("-q,--quiet", zmp.quiet, "No report on stdout");
 
+  tonus::tools::ExperimentOptions experiment;
+  CLI::App* experiment_cmd = app.add_subcommand(
+      "experiment", "Run one of the avatar controller's experiments and write its JSON report and SVG plot");
+  experiment_cmd->add_option("name", experiment.name, "cube-on-hand, brace or track")
+      ->required()
+      ->check(CLI::IsMember({"cube-on-hand", "brace", "track"}));
+  experiment_cmd->add_option("--json", experiment.json, "Write the JSON report here");
+  experiment_cmd->add_option("--svg", experiment.svg, "Write the plot here");
+  experiment_cmd->add_option("--stiffness", experiment.stiffness, "cube-on-hand: the performer's stiffness, 0..1")
+      ->check(CLI::Range(0.0, 1.0));
+  experiment_cmd->add_option("--clip", experiment.clips, "track: BVH clips to follow (default: the bundled CMU walk)");
+  experiment_cmd->add_option("--seconds", experiment.seconds, "track: at most this much of each clip")
+      ->check(CLI::Range(0.1, 600.0));
+  experiment_cmd->add_flag("-q,--quiet", experiment.quiet, "No report on stdout");
+
   CLI11_PARSE(app, argc, argv);
+  if (experiment_cmd->parsed()) return tonus::tools::run_experiment(experiment);
   if (zmp_cmd->parsed()) return tonus::tools::run_zmp_command(zmp);
   if (demo_cmd->parsed()) return tonus::tools::run_protocol_demo(demo);
   if (physics_cmd->parsed()) return tonus::tools::run_physics_demo(physics);

@@ -20,7 +20,7 @@ struct CubeOnHandOptions {
   double drop_height_m = 0.3;
   double cube_mass_kg = 1.0;
   double cube_edge_m = 0.08;
-  std::vector<double> sweep_hz{0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0};  // arm natural frequencies
+  std::vector<double> sweep_hz{0.5, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0};  // arm natural frequencies
 };
 
 struct CubeMode {

@@ -48,6 +48,13 @@ avatar::ReferencePose forearm_forward_pose(const sim::Model& m) {
       .reference();
 }
 
+avatar::ReferencePose arms_down_pose(const sim::Model& m) {
+  return Pose(m)
+      .ball(Bone::RightUpperArm, sim::Quat(Eigen::AngleAxisd(1.3, sim::Vec3::UnitX())))
+      .ball(Bone::LeftUpperArm, sim::Quat(Eigen::AngleAxisd(-1.3, sim::Vec3::UnitX())))
+      .reference();
+}
+
 Kinematics::Kinematics(const sim::Model& m) : m_(&m), d_(sim::make_data(m)) {}
 
 const sim::Data& Kinematics::at(const std::array<double, sim::kMaxQpos>& qpos) {

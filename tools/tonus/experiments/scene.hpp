@@ -32,6 +32,9 @@ class Pose {
 // levelling the hand (its broad face up); left arm lowered by the side.
 avatar::ReferencePose forearm_forward_pose(const sim::Model& m);
 
+// Standing with both arms lowered by the sides (1.3 rad below the T-pose).
+avatar::ReferencePose arms_down_pose(const sim::Model& m);
+
 // World frames of a configuration (forward kinematics on a scratch Data).
 class Kinematics {
  public:
