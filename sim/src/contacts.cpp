@@ -152,7 +152,7 @@ void detect_contacts(const Model& model, Data& data) {
   for (size_t g = 0; g < ngeom; ++g) {
     const Geom& geom = model.geoms[g];
     const Candidate body = body_candidate(model, data, g);
-    if (with_ground && geom.collides_with_ground) collect.pair(body, ground);
+    if (with_ground && data.collisions.body_ground && geom.collides_with_ground) collect.pair(body, ground);
     if (with_objects && geom.collides_with_objects) {
       for (size_t i = 0; i < kMaxObjects; ++i) {
         if (data.objects[i].active) collect.pair(object_candidate(model, data, i), body);

@@ -36,6 +36,7 @@ std::string validate(const AvatarConfig& c) {
   if (!hz_ok(c.root_servo_hz)) return "root_servo_hz: must be in (0, 500]";
   if (!std::isfinite(c.jump_rad) || c.jump_rad <= 0.0) return "jump_rad: must be > 0";
   if (!std::isfinite(c.jump_m) || c.jump_m <= 0.0) return "jump_m: must be > 0";
+  if (!std::isfinite(c.jump_window_s) || c.jump_window_s < 0.0) return "jump_window_s: must be >= 0";
   if (!std::isfinite(c.blowup_energy_factor) || c.blowup_energy_factor < 1.0)
     return "blowup_energy_factor: must be >= 1";
   if (!std::isfinite(c.blowup_energy_margin_j) || c.blowup_energy_margin_j <= 0.0)
@@ -63,6 +64,19 @@ struct AvatarController::Impl {
   std::unique_ptr<detail::IdFeedforward> id;
   std::array<double, sim::kMaxDofs> tau_id{};
   std::uint32_t contact_overflow_seen = 0;
+  // The last references (a ring), to see how far the reference went within the jump window.
+  std::array<std::array<double, sim::kMaxQpos>, kMaxJumpWindowTicks> window{};
+  std::size_t window_ticks = 1;  // from the config
+  std::size_t window_count = 0;
+  std::size_t window_next = 0;
+  void remember(const std::array<double, sim::kMaxQpos>& q) {
+    window[window_next] = q;
+    window_next = (window_next + 1) % window_ticks;
+    window_count = std::min(window_count + 1, window_ticks);
+  }
+  [[nodiscard]] const std::array<double, sim::kMaxQpos>& oldest() const {
+    return window[(window_next + window_ticks - window_count) % window_ticks];
+  }
 };
 
 AvatarController::AvatarController(const sim::Model& model, const AvatarConfig& config)
@@ -98,9 +112,15 @@ AvatarController::Created AvatarController::create(const sim::Model& model, cons
   c.a_->collisions.contacts = config.contacts_a != ContactsA::none;
   c.a_->collisions.objects = false;
   sim::set_root_mode(*c.a_, sim::RootMode::kinematic);
+  c.b_->collisions.body_ground =
+      config.body_ground_b == BodyGround::on ||
+      (config.body_ground_b == BodyGround::automatic && config.root == RootControl::free_servo);
   sim::set_root_mode(*c.b_, config.root == RootControl::kinematic ? sim::RootMode::kinematic : sim::RootMode::free);
   im.in_a = sim::make_inputs(model);
   im.in_b = sim::make_inputs(model);
+  // A is the ideal tracker: no torque limit of its own. The human limits are
+  // B's (its drives), and the feedforward A hands B is bounded by them.
+  im.in_a.torque_limit_nm.fill(0.0);
   write_stiff_gains(model, c.mapper_, config.stiff_hz, config.stiff_ungrouped_hz, config.stiff_damping_ratio, im.in_a);
   if (config.root == RootControl::free_servo) {
     const double w = 2.0 * M_PI * config.root_servo_hz;
@@ -115,6 +135,8 @@ AvatarController::Created AvatarController::create(const sim::Model& model, cons
   }
   im.ref = rest_reference(model);
   im.followed = im.ref;
+  im.window_ticks = std::clamp<std::size_t>(
+      static_cast<std::size_t>(std::lround(config.jump_window_s / model.timestep_s)), 1, kMaxJumpWindowTicks);
   made.controller.emplace(std::move(c));
   made.controller->out_.qpos = model.qpos0;
   return made;
@@ -133,6 +155,8 @@ void AvatarController::resync(const ReferencePose& ref) {
   }
   impl_->prev_qpos = ref.qpos;
   impl_->has_prev = true;
+  impl_->window_count = 0;
+  impl_->remember(ref.qpos);
   if (impl_->id) impl_->id->reset();
 }
 
@@ -175,6 +199,18 @@ void mirror(const sim::Model& m, const ReferencePose& r, sim::Data& d) {
   std::fill_n(d.tau_ff.begin(), m.nv, 0.0);
 }
 
+// Kinetic energy of the articulation alone (sim::energy counts the objects
+// too): a heavy or fast gift in flight is not a blow-up of B.
+double articulation_kinetic_j(const sim::Model& m, const sim::Data& d) {
+  double ke = sim::energy(m, d).kinetic_j;
+  for (const sim::Object& o : d.objects) {
+    if (!o.active) continue;
+    const sim::Vec3 wb = o.quat.toRotationMatrix().transpose() * o.ang_vel;
+    ke -= 0.5 * o.mass_kg * o.lin_vel.squaredNorm() + 0.5 * wb.dot(o.inertia_diag.cwiseProduct(wb));
+  }
+  return ke;
+}
+
 }  // namespace
 
 const TickOutput& AvatarController::tick(const TickInput& in) {
@@ -203,12 +239,14 @@ const TickOutput& AvatarController::tick(const TickInput& in) {
     im.ref.has_velocity = im.ref.has_velocity && fresh;
     resync(im.ref);
   } else {
-    const detail::StepSize step = detail::step_size(m, im.prev_qpos, im.ref.qpos);
+    const detail::StepSize step = detail::step_size(m, im.oldest(), im.ref.qpos);
     if (step.joint_rad > config_.jump_rad || step.root_m > config_.jump_m) {
       flags |= kReferenceJump;
       ++stats_.reference_jumps;
       im.ref.has_velocity = false;
       resync(im.ref);
+    } else {
+      im.remember(im.ref.qpos);
     }
   }
   if (!im.ref.has_velocity || !fresh) detail::difference(m, im.prev_qpos, im.ref.qpos, dt, im.ref.qvel);
@@ -262,8 +300,8 @@ const TickOutput& AvatarController::tick(const TickInput& in) {
   const sim::StepStatus sb = sim::step(m, *b_, im.in_b);
   if (b_->diag.contact_overflow != im.contact_overflow_seen) flags |= kContactOverflow;
   im.contact_overflow_seen = b_->diag.contact_overflow;
-  const double ke_a = sim::energy(m, *a_).kinetic_j;
-  const double ke_b = sim::energy(m, *b_).kinetic_j;
+  const double ke_a = articulation_kinetic_j(m, *a_);
+  const double ke_b = articulation_kinetic_j(m, *b_);
   if (sb == sim::StepStatus::diverged ||
       !(ke_b <= config_.blowup_energy_factor * ke_a + config_.blowup_energy_margin_j)) {
     flags |= kResetB;
@@ -272,6 +310,9 @@ const TickOutput& AvatarController::tick(const TickInput& in) {
     std::copy_n(a_->qvel.begin(), m.nv, b_->qvel.begin());
     b_->drive_in_rows.fill(false);
     b_->drive_impulse.fill(0.0);
+    // A diverged step was undone, B's clock included: the reset stands for this
+    // tick, so the clock moves on (else gifts' lifetimes and time_s stall).
+    if (sb == sim::StepStatus::diverged) b_->time_s += dt;
     for (sim::Object& o : b_->objects) {  // gifts flung in the blow-up are stopped too
       if (!o.active || o.lin_vel.norm() < 100.0) continue;
       o.lin_vel.setZero();

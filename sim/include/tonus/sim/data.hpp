@@ -91,9 +91,10 @@ enum class StepStatus : std::uint8_t {
 // ground: simulation A of the dual scheme runs without contacts (or with the
 // ground only) from the same Model as simulation B.
 struct CollisionSwitches {
-  bool contacts = true;  // false: no contacts at all for this Data
-  bool ground = true;    // false: nothing touches the ground plane
-  bool objects = true;   // false: objects do not touch the articulation (they still meet the ground and each other)
+  bool contacts = true;     // false: no contacts at all for this Data
+  bool ground = true;       // false: nothing touches the ground plane
+  bool objects = true;      // false: objects do not touch the articulation (they still meet the ground and each other)
+  bool body_ground = true;  // false: the articulation does not touch the ground (objects still do)
 };
 
 struct Data {

@@ -43,10 +43,16 @@ enum class RootControl : std::uint8_t {
 
 enum class ContactsA : std::uint8_t { none, ground_only };
 
+// Whether B's body touches the ground. A kinematic root carries the body, so
+// feet that the reference puts into the floor would only be kicked out of it
+// (a retargeted walk's heels dip by centimetres); a free root stands on it.
+enum class BodyGround : std::uint8_t { automatic, on, off };  // automatic: off with a kinematic root
+
 struct AvatarConfig {
   Feedforward feedforward = Feedforward::simulation;
   RootControl root = RootControl::kinematic;
   ContactsA contacts_a = ContactsA::none;
+  BodyGround body_ground_b = BodyGround::automatic;
   StiffnessConfig stiffness = default_stiffness_config();
   // Simulation A: natural frequency per group, Hz, at this damping ratio.
   std::array<double, kGroupCount> stiff_hz{30.0, 30.0, 30.0, 30.0};
@@ -54,10 +60,13 @@ struct AvatarConfig {
   double stiff_damping_ratio = 1.0;
   // Root servo of B in free_servo mode: natural frequency for the whole body's mass and inertia.
   double root_servo_hz = 10.0;
-  // A reference that moves a joint by more than this in one tick, or the root
-  // by more than jump_m, is a jump: A and B are resynced to it.
-  double jump_rad = 0.3;
+  // A reference that turns a joint by more than jump_rad, or moves the root by
+  // more than jump_m, within jump_window_s is a jump (60 rad/s and 25 m/s
+  // sustained over 10 ms: beyond human motion, e.g. a clip's leading T-pose,
+  // a tracker that reconnects): A and B are resynced to it instead of flung.
+  double jump_rad = 0.6;
   double jump_m = 0.25;
+  double jump_window_s = 0.01;
   // B has blown up when its kinetic energy exceeds this factor times A's plus
   // this margin; it is then reset to A's state.
   double blowup_energy_factor = 4.0;
@@ -99,6 +108,7 @@ struct ContactEvent {
   sim::Vec3 normal = sim::Vec3::UnitZ();  // towards the bone
 };
 inline constexpr std::size_t kMaxContactEvents = 32;
+inline constexpr std::size_t kMaxJumpWindowTicks = 64;  // jump_window_s / dt, at most
 
 struct TickInput {
   ReferencePose reference;
