@@ -20,3 +20,9 @@ build/release/bin/tonus physics --seconds 3
 # leaves it, the corrected clip, a JSON report and an SVG plot written.
 build/release/bin/tonus zmp tests/data/cmu_02_walk.bvh -o build/release/cmu_02_walk_balanced.bvh \
   --json build/release/cmu_02_walk_balance.json --svg build/release/cmu_02_walk_balance.svg
+
+# The avatar controller (dual PD: stiff simulation A feeds forward into weak
+# simulation B): the paper's cube experiment, PD only against PD + feedforward,
+# with a JSON report and an SVG plot.
+build/release/bin/tonus experiment cube-on-hand --json build/release/cube_on_hand.json \
+  --svg build/release/cube_on_hand.svg

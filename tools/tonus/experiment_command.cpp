@@ -100,6 +100,43 @@ int brace(const sim::Model& m, const ExperimentOptions& opt) {
   return finish(ex::brace_goals(r), opt.quiet);
 }
 
+int track(const sim::Model& m, const ExperimentOptions& opt) {
+  ex::TrackOptions o;
+  o.clips = opt.clips;
+  if (o.clips.empty()) o.clips.push_back(std::string(TONUS_SOURCE_DIR) + "/tests/data/cmu_02_walk.bvh");
+  o.max_seconds = opt.seconds;
+  const ex::TrackResult r = ex::run_track(m, o);
+  if (!r.error.empty()) {
+    fmt::print(stderr, "tonus experiment track: {}\n", r.error);
+    return 2;
+  }
+  if (!opt.quiet) {
+    fmt::print("track: each clip as the reference (kinematic root, stiffness 0.5, no objects)\n");
+    for (const ex::ClipTrack& c : r.clips) {
+      fmt::print("  {} ({:.1f} s, {} frames, {} clamped by the retargeting):\n", c.clip, c.duration_s, c.frames,
+                 c.frames_clamped);
+      for (const ex::VariantTrack& v : c.variants) {
+        fmt::print(
+            "    {:<16} RMS {:5.2f} deg (max {:5.1f}), hands {:5.1f} mm RMS, lag {:3.0f} ms; tick mean {:5.1f} us, "
+            "p99 {:6.1f}, max {:7.1f}\n",
+            avatar::to_string(v.variant), v.rms_all_rad * 180.0 / M_PI, v.max_rad * 180.0 / M_PI, 1e3 * v.hand_rms_m,
+            1e3 * v.lag_s, v.tick_mean_us, v.tick_p99_us, v.tick_max_us);
+      }
+    }
+    fmt::print("  the same impact (0.45 kg ball at 8 m/s at the chest, arms down):\n");
+    for (const ex::ImpactReaction& i : r.impact)
+      fmt::print("    {:<16} chest peak deflection {:5.2f} mm, impulse {:.2f} N s\n", avatar::to_string(i.variant),
+                 1e3 * i.peak_deflection_m, i.impulse_ns);
+  }
+  std::string err;
+  if (!write_json(opt.json, ex::to_json(r))) return 2;
+  if (!opt.svg.empty() && !ex::write_track_svg(opt.svg, r, err)) {
+    fmt::print(stderr, "tonus experiment: {}\n", err);
+    return 2;
+  }
+  return finish(ex::track_goals(r), opt.quiet);
+}
+
 }  // namespace
 
 int run_experiment(const ExperimentOptions& opt) {
@@ -111,6 +148,7 @@ int run_experiment(const ExperimentOptions& opt) {
   }
   if (opt.name == "cube-on-hand") return cube(*model, opt);
   if (opt.name == "brace") return brace(*model, opt);
+  if (opt.name == "track") return track(*model, opt);
   fmt::print(stderr, "tonus experiment: unknown experiment '{}' (cube-on-hand, brace, track)\n", opt.name);
   return 2;
 }

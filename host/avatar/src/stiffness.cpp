@@ -37,6 +37,11 @@ StiffnessConfig default_stiffness_config() {
   // (elbow ~10 -> 90 N m/rad, Gomi & Osu 1998; Milner 2002), i.e. natural
   // frequencies 1:3 for the same inertia: 2 -> 6 Hz on the forearm's ~0.06 kg m^2.
   c.curves.fill(GroupCurve{1.5, 8.0, 1.0});
+  // The trunk carries inverted pendulums (the head on the neck, the upper body
+  // on the spine): below about sqrt(g / l) / (2 pi) ~ 1.6 Hz (l ~ 0.1 m, the
+  // head's centre above the neck joint) gravity out-pulls the drive and the
+  // head falls to its limit after a knock. 2.5 Hz keeps it up with margin.
+  c.curves[static_cast<size_t>(Group::trunk)] = GroupCurve{2.5, 8.0, 1.0};
   c.curves[static_cast<size_t>(Group::right_arm)] = GroupCurve{1.5, 12.0, 1.0};
   c.curves[static_cast<size_t>(Group::left_arm)] = GroupCurve{1.5, 12.0, 1.0};
   return c;
@@ -79,7 +84,8 @@ StiffnessMapper::StiffnessMapper(const sim::Model& model, const StiffnessConfig&
   for (int i = 0; i < model.nbody; ++i) {
     const sim::Body& b = model.bodies[static_cast<size_t>(i)];
     if (b.joint != sim::JointType::ball && b.joint != sim::JointType::hinge) continue;
-    const int g = i < static_cast<int>(sim::kBoneCount) ? config_.bone_group[static_cast<size_t>(i)] : kNoGroup;
+    const int g = i < static_cast<int>(sim::kBoneCount) ? static_cast<int>(config_.bone_group[static_cast<size_t>(i)])
+                                                        : static_cast<int>(kNoGroup);
     for (int k = b.dof_adr; k < b.dof_adr + b.dof_num; ++k) dof_group_[static_cast<size_t>(k)] = g;
   }
   target_.fill(config_.initial);

@@ -51,6 +51,7 @@ std::string run_one(const sim::Model& m, const BraceOptions& opt, Bone bone, dou
       p.peak_deflection_m = d;
       peak_at = k;
     }
+    p.final_deflection_m = d;
     if (k % 5 == 0) {
       p.t_s.push_back((k + 1) * dt);
       p.deflection_m.push_back(d);

@@ -24,9 +24,10 @@ struct BraceOptions {
 struct BracePoint {
   double stiffness = 0.0;
   double trunk_frequency_hz = 0.0;
-  double peak_deflection_m = 0.0;  // largest displacement of the hit segment's centre from its place before the throw
-  double time_to_peak_s = 0.0;     // from the first contact
-  double impulse_ns = 0.0;         // total normal impulse the ball gave the body
+  double peak_deflection_m = 0.0;   // largest displacement of the hit segment's centre from its place before the throw
+  double time_to_peak_s = 0.0;      // from the first contact
+  double impulse_ns = 0.0;          // total normal impulse the ball gave the body
+  double final_deflection_m = 0.0;  // where the segment is at the end: it must come back (no flop)
   bool hit = false;
   std::vector<double> t_s, deflection_m;  // for the plot
 };

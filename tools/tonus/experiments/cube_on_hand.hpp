@@ -14,7 +14,7 @@
 namespace tonus::experiments {
 
 struct CubeOnHandOptions {
-  double stiffness = 0.5;  // the performer's stiffness for every group
+  double stiffness = 1.0;  // the performer's stiffness for every group (braced, as for a catch)
   double settle_s = 2.0;   // held before the drop
   double after_s = 3.0;    // watched after the drop
   double drop_height_m = 0.3;

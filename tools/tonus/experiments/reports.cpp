@@ -90,8 +90,12 @@ bool write_cube_svg(const std::string& path, const CubeOnHandResult& r, std::str
 
 std::vector<Goal> brace_goals(const BraceResult& r) {
   std::vector<Goal> g;
-  for (const BraceTarget& t : r.targets)
+  for (const BraceTarget& t : r.targets) {
     g.push_back({"the " + t.name + "'s peak deflection falls strictly with stiffness", t.strictly_decreasing});
+    bool back = !t.points.empty();
+    for (const BracePoint& p : t.points) back = back && p.final_deflection_m < 0.005;
+    g.push_back({"the " + t.name + " comes back within 5 mm at every stiffness", back});
+  }
   return g;
 }
 
@@ -104,6 +108,7 @@ json to_json(const BraceResult& r) {
                      {"peak_deflection_m", p.peak_deflection_m},
                      {"time_to_peak_s", p.time_to_peak_s},
                      {"impulse_ns", p.impulse_ns},
+                     {"final_deflection_m", p.final_deflection_m},
                      {"trunk_frequency_hz", p.trunk_frequency_hz},
                      {"hit", p.hit}});
     }
@@ -128,6 +133,86 @@ bool write_brace_svg(const std::string& path, const BraceResult& r, std::string&
     panels.push_back(std::move(p));
   }
   return write_svg(path, "brace: a 0.45 kg ball at 8 m/s, five stiffness levels", panels, error);
+}
+
+namespace {
+
+const VariantTrack* find(const ClipTrack& c, avatar::Feedforward v) {
+  for (const VariantTrack& x : c.variants) {
+    if (x.variant == v) return &x;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+std::vector<Goal> track_goals(const TrackResult& r) {
+  std::vector<Goal> g;
+  for (const ClipTrack& c : r.clips) {
+    const VariantTrack* a = find(c, avatar::Feedforward::simulation);
+    const VariantTrack* b = find(c, avatar::Feedforward::inverse_dynamics);
+    const VariantTrack* n = find(c, avatar::Feedforward::none);
+    if (a == nullptr || b == nullptr || n == nullptr) continue;
+    g.push_back({c.clip + ": both feedforward variants track closer than PD only",
+                 a->rms_all_rad < n->rms_all_rad && b->rms_all_rad < n->rms_all_rad});
+    g.push_back({c.clip + ": no resets of A or B", a->resets + b->resets + n->resets == 0});
+  }
+  return g;
+}
+
+json to_json(const TrackResult& r) {
+  json clips = json::array();
+  for (const ClipTrack& c : r.clips) {
+    json variants = json::object();
+    for (const VariantTrack& v : c.variants) {
+      json per_joint = json::object();
+      for (std::size_t b = 1; b < sim::kBoneCount; ++b) per_joint[std::string(sim::kBones[b].name)] = v.rms_rad[b];
+      variants[std::string(avatar::to_string(v.variant))] = {
+          {"rms_rad", per_joint},
+          {"rms_all_joints_rad", v.rms_all_rad},
+          {"max_rad", v.max_rad},
+          {"hand_rms_m", v.hand_rms_m},
+          {"reference_lag_s", v.lag_s},
+          {"tick_us",
+           {{"mean", v.tick_mean_us}, {"p50", v.tick_p50_us}, {"p99", v.tick_p99_us}, {"max", v.tick_max_us}}},
+          {"reference_jumps", v.jumps},
+          {"reference_clamped_ticks", v.clamped},
+          {"resets", v.resets}};
+    }
+    clips.push_back({{"clip", c.clip},
+                     {"seconds", c.duration_s},
+                     {"frames", c.frames},
+                     {"frames_clamped_by_retargeting", c.frames_clamped},
+                     {"variants", variants}});
+  }
+  json impact = json::object();
+  for (const ImpactReaction& i : r.impact)
+    impact[std::string(avatar::to_string(i.variant))] = {{"chest_peak_deflection_m", i.peak_deflection_m},
+                                                         {"impulse_ns", i.impulse_ns}};
+  return {{"experiment", "track"},
+          {"clips", clips},
+          {"impact_ball_at_chest", impact},
+          {"goals", goals_json(track_goals(r))}};
+}
+
+bool write_track_svg(const std::string& path, const TrackResult& r, std::string& error) {
+  std::vector<Panel> panels;
+  for (const ClipTrack& c : r.clips) {
+    Panel p{c.clip + ": RMS tracking error per joint (1 Spine ... 20 RightToes)",
+            "joint (Bone index)",
+            "RMS error, degrees",
+            {}};
+    for (const VariantTrack& v : c.variants) {
+      Series s{std::string(avatar::to_string(v.variant)), {}, {}, true};
+      for (std::size_t b = 1; b < sim::kBoneCount; ++b) {
+        s.x.push_back(static_cast<double>(b));
+        s.y.push_back(v.rms_rad[b] * 180.0 / M_PI);
+      }
+      p.series.push_back(std::move(s));
+    }
+    panels.push_back(std::move(p));
+  }
+  return write_svg(path, "track: a captured clip as the reference, three feedforward variants", panels, error);
 }
 
 }  // namespace tonus::experiments

@@ -7,6 +7,7 @@
 
 #include "brace.hpp"
 #include "cube_on_hand.hpp"
+#include "track.hpp"
 
 namespace tonus::experiments {
 
@@ -22,6 +23,10 @@ bool write_cube_svg(const std::string& path, const CubeOnHandResult& r, std::str
 std::vector<Goal> brace_goals(const BraceResult& r);
 nlohmann::json to_json(const BraceResult& r);
 bool write_brace_svg(const std::string& path, const BraceResult& r, std::string& error);
+
+std::vector<Goal> track_goals(const TrackResult& r);
+nlohmann::json to_json(const TrackResult& r);
+bool write_track_svg(const std::string& path, const TrackResult& r, std::string& error);
 
 nlohmann::json goals_json(const std::vector<Goal>& goals);
 

@@ -68,13 +68,21 @@ void panel(fmt::ostream& out, const Panel& p, double y0) {
   out.print("<rect x='{:.1f}' y='{:.1f}' width='{:.1f}' height='{:.1f}' fill='none' stroke='#444'/>\n", kLeft,
             y0 + kTop, w, h);
   const double xs = tick_step(xmax - xmin), ys = tick_step(ymax - ymin);
-  for (double x = std::ceil(xmin / xs) * xs; x <= xmax + 1e-9 * xs; x += xs) {
+  const auto ticks = [](double lo, double hi, double step) {
+    const double first = std::ceil(lo / step);
+    return std::pair{first, static_cast<int>(std::floor(hi / step + 1e-9) - first)};
+  };
+  const auto [x0, nx] = ticks(xmin, xmax, xs);
+  for (int i = 0; i <= nx; ++i) {
+    const double x = (x0 + i) * xs;
     out.print("<line x1='{0:.1f}' x2='{0:.1f}' y1='{1:.1f}' y2='{2:.1f}' stroke='#ddd'/>", X(x), y0 + kTop,
               y0 + kTop + h);
     out.print("<text x='{:.1f}' y='{:.1f}' font-size='11' text-anchor='middle'>{:g}</text>\n", X(x),
               y0 + kTop + h + 15.0, x);
   }
-  for (double y = std::ceil(ymin / ys) * ys; y <= ymax + 1e-9 * ys; y += ys) {
+  const auto [y0t, ny] = ticks(ymin, ymax, ys);
+  for (int i = 0; i <= ny; ++i) {
+    const double y = (y0t + i) * ys;
     out.print("<line x1='{0:.1f}' x2='{1:.1f}' y1='{2:.1f}' y2='{2:.1f}' stroke='#ddd'/>", kLeft, kLeft + w, Y(y));
     out.print("<text x='{:.1f}' y='{:.1f}' font-size='11' text-anchor='end'>{:g}</text>\n", kLeft - 5.0, Y(y) + 4.0,
               std::abs(y) < 1e-12 * ys ? 0.0 : y);

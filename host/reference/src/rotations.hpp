@@ -1,0 +1,39 @@
+// Rotation helpers of the retargeting: a frame fixed by one exact and one
+// approximate direction, the least rotation that aims a bone, the signed
+// angle a hinge needs, and clamping into the model's joint ranges.
+#pragma once
+
+#include "tonus/sim/model.hpp"
+
+namespace tonus::reference::detail {
+
+using sim::Quat;
+using sim::Vec3;
+
+// Below this length a direction is treated as undefined.
+inline constexpr double kTiny = 1e-9;
+
+// The rotation W with W * r == d (both made unit) and W * s as close to `a`
+// as that allows (s and a taken orthogonal to r and d). False, and W
+// untouched, when a lies along d or s along r.
+bool frame_match(const Vec3& r, const Vec3& s, const Vec3& d, const Vec3& a, Quat& w);
+
+// `from` turned by the least rotation that takes from * r onto d.
+Quat aim(const Quat& from, const Vec3& r, const Vec3& d);
+
+// The angle about `axis` (unit) that turns v0 closest to v (both projected on
+// the plane normal to the axis); 0 when either projection vanishes.
+double angle_about(const Vec3& axis, const Vec3& v0, const Vec3& v);
+
+// The angle q turns about the unit axis t (the twist of a swing-twist decomposition), in [-pi, pi].
+double twist_about(const Quat& q, const Vec3& t);
+
+// Clamps a ball joint's quaternion into its swing cone (about the twist axis)
+// and twist range, by a swing-twist decomposition q = swing * twist, as the
+// physics core measures them. True when it had to move.
+bool clamp_ball(Quat& q, const sim::JointLimit& limit);
+
+// Clamps a hinge angle into its range. True when it had to move.
+bool clamp_hinge(double& angle_rad, const sim::JointLimit& limit);
+
+}  // namespace tonus::reference::detail

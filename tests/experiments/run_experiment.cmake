@@ -1,0 +1,10 @@
+# Runs `tonus experiment NAME --json OUT`, then checks OUT with check_report.py.
+execute_process(COMMAND ${TONUS} experiment ${NAME} --json ${OUT} -q RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "tonus experiment ${NAME} exited with ${rc}")
+endif()
+execute_process(COMMAND python3 ${CHECK} ${NAME} ${OUT} RESULT_VARIABLE rc2 OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("${out}${err}")
+if(NOT rc2 EQUAL 0)
+  message(FATAL_ERROR "the ${NAME} report does not hold what it should")
+endif()
