@@ -429,7 +429,7 @@ SpawnResult AvatarController::throw_ball(const ThrowBall& s) {
   const sim::Vec3 target = b_->xgeom[static_cast<size_t>(impl_->bone_geom[bone])].pos;
   sim::Vec3 dir = s.direction;
   if (dir.norm() < 1e-9) dir = -b_->xbody[0].rot.col(0);  // from straight ahead
-  dir.normalize();
+  dir.stableNormalize();  // a huge vector is a direction too (normalize() would overflow to zero)
   const double t = s.distance_m / s.speed_mps;
   const sim::Vec3 g = m.features.gravity ? m.gravity : sim::Vec3::Zero();
   sim::ObjectSpec o;
