@@ -438,16 +438,7 @@ SpawnResult AvatarController::throw_ball(const ThrowBall& s) {
   o.material = {s.friction, s.restitution};
   o.pos = target - dir * s.distance_m;
   o.lin_vel = dir * s.speed_mps - 0.5 * g * t;  // lands on the target despite gravity
-  const sim::AddObjectResult added = sim::add_object(*b_, o);
-  if (added.error != sim::ObjectError::none) {
-    r.error = to_gift_error(added.error);
-    ++stats_.gifts_refused;
-    return r;
-  }
-  r.id = {added.handle.slot, added.handle.generation};
-  impl_->gifts[static_cast<size_t>(r.id.slot)] = {true, r.id, s.lifetime_s > 0.0 ? b_->time_s + s.lifetime_s : 0.0};
-  ++stats_.gifts_spawned;
-  return r;
+  return spawn(o, s.lifetime_s);
 }
 
 SpawnResult AvatarController::drop_cube(const DropCube& s) {
@@ -471,6 +462,11 @@ SpawnResult AvatarController::drop_cube(const DropCube& s) {
   o.mass_kg = s.mass_kg;
   o.material.friction = s.friction;
   o.pos = p.pos + sim::Vec3(0, 0, top_above_centre(model_->geoms[g].shape, p) + s.height_m + 0.5 * s.edge_m);
+  return spawn(o, s.lifetime_s);
+}
+
+SpawnResult AvatarController::spawn(const sim::ObjectSpec& o, double lifetime_s) {
+  SpawnResult r;
   const sim::AddObjectResult added = sim::add_object(*b_, o);
   if (added.error != sim::ObjectError::none) {
     r.error = to_gift_error(added.error);
@@ -478,7 +474,7 @@ SpawnResult AvatarController::drop_cube(const DropCube& s) {
     return r;
   }
   r.id = {added.handle.slot, added.handle.generation};
-  impl_->gifts[static_cast<size_t>(r.id.slot)] = {true, r.id, s.lifetime_s > 0.0 ? b_->time_s + s.lifetime_s : 0.0};
+  impl_->gifts[static_cast<size_t>(r.id.slot)] = {true, r.id, lifetime_s > 0.0 ? b_->time_s + lifetime_s : 0.0};
   ++stats_.gifts_spawned;
   return r;
 }

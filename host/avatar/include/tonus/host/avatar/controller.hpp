@@ -193,6 +193,7 @@ class AvatarController {
 
  private:
   AvatarController(const sim::Model& model, const AvatarConfig& config);
+  SpawnResult spawn(const sim::ObjectSpec& spec, double lifetime_s);  // a checked gift into B
   struct Impl;
 
   const sim::Model* model_;
