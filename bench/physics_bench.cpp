@@ -15,6 +15,7 @@
 #include <memory>
 #include <string>
 
+#include "forwarding_reporter.hpp"
 #include "tonus/sim/humanoid.hpp"
 #include "tonus/sim/mjcf.hpp"
 #include "tonus/sim/objects.hpp"
@@ -134,57 +135,32 @@ void BM_MujocoStep(benchmark::State& state) {
 }
 BENCHMARK(BM_MujocoStep);
 
-// Forwards to the reporter the flags ask for and keeps each run's time.
-class RatioReporter : public benchmark::BenchmarkReporter {
+// Keeps each run's time (the mean over repetitions when there are several, else the run).
+class RatioReporter : public tonus::bench::ForwardingReporter {
  public:
-  explicit RatioReporter(bool json) {
-    if (json) {
-      inner_ = std::make_unique<benchmark::JSONReporter>();
-    } else {
-      inner_ = std::make_unique<benchmark::ConsoleReporter>(isatty(STDOUT_FILENO) != 0
-                                                                ? benchmark::ConsoleReporter::OO_ColorTabular
-                                                                : benchmark::ConsoleReporter::OO_Tabular);
-    }
-    inner_->SetOutputStream(&std::cout);
-    inner_->SetErrorStream(&std::cerr);
-  }
-  bool ReportContext(const Context& c) override { return inner_->ReportContext(c); }
-  void ReportRuns(const std::vector<Run>& runs) override {
-    // One time per benchmark: the mean over repetitions when there are several, else the run.
-    for (const Run& r : runs) {
-      if (r.error_occurred) continue;
-      const std::string& name = r.run_name.function_name;
-      if (r.run_type == Run::RT_Aggregate && r.aggregate_name == "mean") {
-        times_[name] = {r.GetAdjustedRealTime() * unit_seconds(r.time_unit),
-                        r.GetAdjustedCPUTime() * unit_seconds(r.time_unit), true};
-      } else if (r.run_type == Run::RT_Iteration && !times_[name].from_mean && r.repetition_index <= 0) {
-        const auto n = static_cast<double>(r.iterations);
-        times_[name] = {r.real_accumulated_time / n, r.cpu_accumulated_time / n, false};
-      }
-    }
-    inner_->ReportRuns(runs);
-  }
-  void Finalize() override { inner_->Finalize(); }
+  using ForwardingReporter::ForwardingReporter;
   struct Times {
     double real_s = 0.0, cpu_s = 0.0;
     bool from_mean = false;
   };
-  static double unit_seconds(benchmark::TimeUnit u) {
-    switch (u) {
-      case benchmark::kNanosecond: return 1e-9;
-      case benchmark::kMicrosecond: return 1e-6;
-      case benchmark::kMillisecond: return 1e-3;
-      case benchmark::kSecond: return 1.0;
-    }
-    return 1e-9;
-  }
   [[nodiscard]] Times times(const std::string& name) const {
     const auto it = times_.find(name);
     return it == times_.end() ? Times{} : it->second;
   }
 
+ protected:
+  void keep(const Run& r) override {
+    const std::string& name = r.run_name.function_name;
+    if (r.run_type == Run::RT_Aggregate && r.aggregate_name == "mean") {
+      times_[name] = {r.GetAdjustedRealTime() * unit_seconds(r.time_unit),
+                      r.GetAdjustedCPUTime() * unit_seconds(r.time_unit), true};
+    } else if (r.run_type == Run::RT_Iteration && !times_[name].from_mean && r.repetition_index <= 0) {
+      const auto n = static_cast<double>(r.iterations);
+      times_[name] = {r.real_accumulated_time / n, r.cpu_accumulated_time / n, false};
+    }
+  }
+
  private:
-  std::unique_ptr<benchmark::BenchmarkReporter> inner_;
   std::map<std::string, Times> times_;
 };
 
