@@ -99,6 +99,13 @@ double StiffnessMapper::frequency_hz(size_t group, double s) const {
 }
 
 void StiffnessMapper::recompute() {
+  // One curve evaluation per group (the last entry: ungrouped joints), then per dof.
+  std::array<double, kGroupCount + 1> w{};
+  std::array<double, kGroupCount + 1> zeta{};
+  for (size_t g = 0; g <= kGroupCount; ++g) {
+    w[g] = 2.0 * M_PI * frequency_hz(g, g < kGroupCount ? applied_[g] : 0.0);
+    zeta[g] = (g < kGroupCount ? config_.curves[g] : config_.ungrouped).damping_ratio;
+  }
   for (size_t d = 0; d < static_cast<size_t>(nv_); ++d) {
     const int g = dof_group_[d];
     if (g == kUndriven) {
@@ -106,10 +113,8 @@ void StiffnessMapper::recompute() {
       continue;
     }
     const auto gu = g >= 0 ? static_cast<size_t>(g) : kGroupCount;
-    const GroupCurve& c = gu < kGroupCount ? config_.curves[gu] : config_.ungrouped;
-    const double w = 2.0 * M_PI * frequency_hz(gu, gu < kGroupCount ? applied_[gu] : 0.0);
-    kp_[d] = w * w * inertia_[d];
-    kd_[d] = 2.0 * c.damping_ratio * w * inertia_[d];
+    kp_[d] = w[gu] * w[gu] * inertia_[d];
+    kd_[d] = 2.0 * zeta[gu] * w[gu] * inertia_[d];
   }
 }
 
@@ -141,7 +146,7 @@ void StiffnessMapper::set_inertia(std::span<const double> mass, int nv) {
     const double i = mass[d * n + d];
     if (std::isfinite(i) && i > 0.0) inertia_[d] = i;
   }
-  recompute();
+  recompute();  // cheap: one curve evaluation per group
 }
 
 void StiffnessMapper::set_applied(const std::array<double, kGroupCount>& s) {
