@@ -6,11 +6,13 @@
 #include <cmath>
 #include <fstream>
 #include <sstream>
+#include <string>
 
 #include "tonus/host/balance/apply.hpp"
 #include "tonus/host/balance/convert.hpp"
 #include "tonus/host/balance/filter.hpp"
 #include "tonus/host/motion/bvh.hpp"
+#include "tonus/sim/human_bones.hpp"
 #include "zmp_outputs.hpp"
 
 namespace tonus::tools {
@@ -123,6 +125,13 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
     fmt::print("  skeleton: {} ({} joints), {} frames at {:.0f} Hz, unit {}{}\n", mapping.map.convention,
                read.clip.joints.size(), read.clip.frame_count, 1.0 / read.clip.frame_time_s, conv.unit_name,
                conv.unit_guessed ? " (guessed)" : "");
+    std::string bones;
+    for (std::size_t b = 0; b < sim::kBoneCount; ++b) {
+      const int j = mapping.map.joint[b];
+      bones += fmt::format("{}{} = {}", b == 0 ? "" : ", ", sim::kBones[b].name,
+                           j < 0 ? std::string("(synthesised)") : read.clip.joints[static_cast<std::size_t>(j)].name);
+    }
+    fmt::print("  bones: {}\n", bones);
     for (const std::string& m : conv.messages) fmt::print("  note: {}\n", m);
     for (const auto& w : read.warnings) fmt::print("  warning (line {}): {}\n", w.line, w.message);
   }

@@ -1,9 +1,15 @@
-// Which joint of a BVH skeleton is which HumanBodyBones bone. Built in: the
-// CMU conventions (cgspeed's MotionBuilder-friendly release), Bandai Namco's
-// motion datasets, Mixamo (any "mixamorig<N>:" prefix) and Unity's own names;
-// the best-matching convention wins. A small mapping text overrides or adds
-// entries, one per line, the bone first: `LeftUpperLeg = Thigh_L` ('#' starts
-// a comment).
+// Which joint of a BVH skeleton is which HumanBodyBones bone. Built in, by
+// joint names (case-insensitive, namespace and asset prefixes such as
+// "mixamorig:", "Character1_", "Skeleton_", "DEF-" ignored): MotionBuilder
+// HumanIK, CMU (cgspeed's MotionBuilder-friendly release), Mixamo,
+// Perception Neuron, Rokoko, Xsens MVN, Unity HumanBodyBones, VRM (J_Bip_*),
+// Bandai Namco's motion datasets, Blender Rigify, 3dsMax Biped, Daz and
+// OptiTrack Motive; the convention that finds the most bones wins. When the
+// names give fewer than half the required bones, the skeleton's rest pose is
+// used instead (convention "topology"): legs to the lowest ends, arms to the
+// ends farthest to the sides, the head to the highest end. A small mapping
+// text overrides or adds entries, one per line, the bone first:
+// `LeftUpperLeg = Thigh_L` ('#' starts a comment).
 #pragma once
 
 #include <array>
@@ -17,7 +23,7 @@
 namespace tonus::balance {
 
 struct SkeletonMap {
-  std::string convention;                    // the built-in table used, or "custom"
+  std::string convention;                    // the built-in table used ("Xsens MVN", "topology", ...), + " + custom"
   std::array<int, sim::kBoneCount> joint{};  // the clip's joint index per bone; -1 when the skeleton lacks it
 };
 
