@@ -119,13 +119,6 @@ avatar::ThrowBall ball_spec() {
   return b;
 }
 
-int first_geom(const sim::Model& m, Bone b) {
-  for (int g = 0; g < m.ngeom; ++g) {
-    if (m.geoms[static_cast<size_t>(g)].body == static_cast<int>(sim::index(b))) return g;
-  }
-  return -1;
-}
-
 // Per-iteration times, preallocated so the loop does not allocate.
 class Samples {
  public:
@@ -193,7 +186,8 @@ struct AvatarScene {
   [[nodiscard]] bool cube_on_hand() const {
     const sim::Object* o = sim::find_object(c->sim_b(), {cube.slot, cube.generation});
     const sim::Model& m = humanoid();
-    const Vec3 hand = c->sim_b().xgeom[static_cast<size_t>(first_geom(m, Bone::RightHand))].pos;
+    const Vec3 hand =
+        c->sim_b().xgeom[static_cast<size_t>(m.first_geom(static_cast<int>(sim::index(Bone::RightHand))))].pos;
     return o != nullptr && o->pos.z() > hand.z() && (o->pos - hand).head<2>().norm() < 0.1;
   }
 };
@@ -459,7 +453,7 @@ std::unique_ptr<MujocoScene> make_mujoco_scene(bool lively) {
   }
   // Where throw_ball launches from, and how fast (AvatarController::throw_ball's flight).
   {
-    const Vec3 target = b.xgeom[static_cast<size_t>(first_geom(m, Bone::Chest))].pos;
+    const Vec3 target = b.xgeom[static_cast<size_t>(m.first_geom(static_cast<int>(sim::index(Bone::Chest))))].pos;
     const Vec3 dir = -b.xbody[0].rot.col(0).normalized();
     const double t = ball.distance_m / ball.speed_mps;
     const Vec3 g = m.features.gravity ? m.gravity : Vec3::Zero();
@@ -565,7 +559,7 @@ std::unique_ptr<MujocoScene> make_mujoco_scene(bool lively) {
                                              std::string(m.bodies[sim::index(Bone::RightHand)].name_view()).c_str())];
   mj_forward(mm, md);
   // The same configuration in both: B's hand where MuJoCo puts it.
-  const Vec3 hand_b = b.xgeom[static_cast<size_t>(first_geom(m, Bone::RightHand))].pos;
+  const Vec3 hand_b = b.xgeom[static_cast<size_t>(m.first_geom(static_cast<int>(sim::index(Bone::RightHand))))].pos;
   const Vec3 hand_mj = mj_vec3(md->geom_xpos, s->hand_geom);
   if ((hand_b - hand_mj).norm() > 1e-6) {
     s->error = "MuJoCo's hand is " + num((hand_b - hand_mj).norm()) + " m from B's";

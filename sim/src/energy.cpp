@@ -24,9 +24,10 @@ Energy energy(const Model& model, const Data& data) {
     if (!o.active) continue;
     const Mat3 r = o.quat.toRotationMatrix();
     const Vec3 wb = r.transpose() * o.ang_vel;
-    e.kinetic_j += 0.5 * o.mass_kg * o.lin_vel.squaredNorm() + 0.5 * wb.dot(o.inertia_diag.cwiseProduct(wb));
+    e.objects_kinetic_j += 0.5 * o.mass_kg * o.lin_vel.squaredNorm() + 0.5 * wb.dot(o.inertia_diag.cwiseProduct(wb));
     e.potential_j -= o.mass_kg * g.dot(o.pos);
   }
+  e.kinetic_j += e.objects_kinetic_j;
   return e;
 }
 

@@ -22,9 +22,8 @@ SwingTwist swing_twist(const Quat& q_in, const Vec3& t) {
   return st;
 }
 
-namespace {
-
 bool clamp_ball(const JointLimit& lim, Quat& q) {
+  if (!lim.enabled || !std::isfinite(q.norm()) || q.norm() < 1e-9) return false;
   const SwingTwist st = swing_twist(q, lim.twist_axis);
   const double twist = std::clamp(st.twist_rad, lim.lower_rad, lim.upper_rad);
   const double swing = std::min(st.swing_rad, lim.swing_max_rad);
@@ -35,30 +34,29 @@ bool clamp_ball(const JointLimit& lim, Quat& q) {
   return true;
 }
 
-}  // namespace
+bool clamp_hinge(const JointLimit& lim, double& angle_rad) {
+  if (!lim.enabled || !std::isfinite(angle_rad)) return false;
+  const double x = std::clamp(angle_rad, lim.lower_rad, lim.upper_rad);
+  if (x == angle_rad) return false;
+  angle_rad = x;
+  return true;
+}
 
 int clamp_to_limits(const Model& model, std::span<double> qpos) {
   int moved = 0;
   for (std::size_t i = 0; i < static_cast<std::size_t>(model.nbody); ++i) {
     const Body& b = model.bodies[i];
-    if (!b.limit.enabled) continue;
     const auto a = static_cast<std::size_t>(b.qpos_adr);
     if (b.joint == JointType::hinge) {
-      const double x = std::clamp(qpos[a], b.limit.lower_rad, b.limit.upper_rad);
-      if (x != qpos[a] && std::isfinite(qpos[a])) {
-        qpos[a] = x;
-        ++moved;
-      }
+      moved += clamp_hinge(b.limit, qpos[a]) ? 1 : 0;
     } else if (b.joint == JointType::ball) {
       Quat q(qpos[a], qpos[a + 1], qpos[a + 2], qpos[a + 3]);
-      if (!std::isfinite(q.norm()) || q.norm() < 1e-9) continue;
-      if (clamp_ball(b.limit, q)) {
-        qpos[a] = q.w();
-        qpos[a + 1] = q.x();
-        qpos[a + 2] = q.y();
-        qpos[a + 3] = q.z();
-        ++moved;
-      }
+      if (!clamp_ball(b.limit, q)) continue;
+      qpos[a] = q.w();
+      qpos[a + 1] = q.x();
+      qpos[a + 2] = q.y();
+      qpos[a + 3] = q.z();
+      ++moved;
     }
   }
   return moved;

@@ -18,6 +18,13 @@ int Model::body_index(std::string_view n) const {
   return -1;
 }
 
+int Model::first_geom(int body) const {
+  for (int g = 0; g < ngeom; ++g) {
+    if (geoms[static_cast<std::size_t>(g)].body == body) return g;
+  }
+  return -1;
+}
+
 StepInputs make_inputs(const Model& model) {
   StepInputs in;
   in.target_qpos = model.qpos0;

@@ -51,12 +51,8 @@ Hit hit_by(const TickOutput& o, GiftId id) {
 
 double shape_radius(Bone b) {
   const sim::Model& m = humanoid();
-  for (int g = 0; g < m.ngeom; ++g) {
-    if (m.geoms[static_cast<size_t>(g)].body == static_cast<int>(sim::index(b))) {
-      return m.geoms[static_cast<size_t>(g)].shape.radius_m;
-    }
-  }
-  return 0.0;
+  const int g = m.first_geom(static_cast<int>(sim::index(b)));
+  return g >= 0 ? m.geoms[static_cast<size_t>(g)].shape.radius_m : 0.0;
 }
 
 }  // namespace

@@ -128,11 +128,7 @@ AvatarController::Created AvatarController::create(const sim::Model& model, cons
     const double i = c.mapper_.inertia(3);  // the whole body about the root's first rotation axis
     im.in_b.root_servo = {true, w * w * m, 2.0 * w * m, w * w * i, 2.0 * w * i};
   }
-  im.bone_geom.fill(-1);
-  for (int g = model.ngeom - 1; g >= 0; --g) {
-    const int body = model.geoms[static_cast<size_t>(g)].body;
-    if (body >= 0 && body < static_cast<int>(sim::kBoneCount)) im.bone_geom[static_cast<size_t>(body)] = g;
-  }
+  for (size_t b = 0; b < sim::kBoneCount; ++b) im.bone_geom[b] = model.first_geom(static_cast<int>(b));
   im.ref = rest_reference(model);
   im.followed = im.ref;
   im.window_ticks = std::clamp<std::size_t>(
@@ -199,16 +195,10 @@ void mirror(const sim::Model& m, const ReferencePose& r, sim::Data& d) {
   std::fill_n(d.tau_ff.begin(), m.nv, 0.0);
 }
 
-// Kinetic energy of the articulation alone (sim::energy counts the objects
-// too): a heavy or fast gift in flight is not a blow-up of B.
+// Kinetic energy of the articulation alone: a heavy or fast gift in flight is not a blow-up of B.
 double articulation_kinetic_j(const sim::Model& m, const sim::Data& d) {
-  double ke = sim::energy(m, d).kinetic_j;
-  for (const sim::Object& o : d.objects) {
-    if (!o.active) continue;
-    const sim::Vec3 wb = o.quat.toRotationMatrix().transpose() * o.ang_vel;
-    ke -= 0.5 * o.mass_kg * o.lin_vel.squaredNorm() + 0.5 * wb.dot(o.inertia_diag.cwiseProduct(wb));
-  }
-  return ke;
+  const sim::Energy e = sim::energy(m, d);
+  return e.kinetic_j - e.objects_kinetic_j;
 }
 
 }  // namespace

@@ -22,13 +22,6 @@ namespace {
 
 sim::Quat quat_at(std::span<const double> q, size_t a) { return {q[a], q[a + 1], q[a + 2], q[a + 3]}; }
 
-// The rotation vector taking a to b in a's frame (the shorter way).
-sim::Vec3 rotation_between(const sim::Quat& a, const sim::Quat& b) {
-  sim::Quat d = a.conjugate() * b;
-  if (d.w() < 0.0) d.coeffs() = -d.coeffs();
-  return sim::quat_log(d.normalized());
-}
-
 }  // namespace
 
 bool reference_usable(const sim::Model& model, const ReferencePose& ref) {
@@ -69,10 +62,10 @@ StepSize step_size(const sim::Model& model, std::span<const double> q0, std::spa
     switch (b.joint) {
       case sim::JointType::free:
         s.root_m = (sim::Vec3(q1[a], q1[a + 1], q1[a + 2]) - sim::Vec3(q0[a], q0[a + 1], q0[a + 2])).norm();
-        s.joint_rad = std::max(s.joint_rad, rotation_between(quat_at(q0, a + 3), quat_at(q1, a + 3)).norm());
+        s.joint_rad = std::max(s.joint_rad, sim::quat_between(quat_at(q0, a + 3), quat_at(q1, a + 3)).norm());
         break;
       case sim::JointType::ball:
-        s.joint_rad = std::max(s.joint_rad, rotation_between(quat_at(q0, a), quat_at(q1, a)).norm());
+        s.joint_rad = std::max(s.joint_rad, sim::quat_between(quat_at(q0, a), quat_at(q1, a)).norm());
         break;
       case sim::JointType::hinge: s.joint_rad = std::max(s.joint_rad, std::abs(q1[a] - q0[a])); break;
       case sim::JointType::fixed: break;
@@ -90,12 +83,12 @@ void difference(const sim::Model& model, std::span<const double> q0, std::span<c
     switch (b.joint) {
       case sim::JointType::free: {
         for (size_t k = 0; k < 3; ++k) qvel[d + k] = (q1[a + k] - q0[a + k]) / dt_s;
-        const sim::Vec3 w = rotation_between(quat_at(q0, a + 3), quat_at(q1, a + 3)) / dt_s;
+        const sim::Vec3 w = sim::quat_between(quat_at(q0, a + 3), quat_at(q1, a + 3)) / dt_s;
         for (size_t k = 0; k < 3; ++k) qvel[d + 3 + k] = w(static_cast<Eigen::Index>(k));
         break;
       }
       case sim::JointType::ball: {
-        const sim::Vec3 w = rotation_between(quat_at(q0, a), quat_at(q1, a)) / dt_s;
+        const sim::Vec3 w = sim::quat_between(quat_at(q0, a), quat_at(q1, a)) / dt_s;
         for (size_t k = 0; k < 3; ++k) qvel[d + k] = w(static_cast<Eigen::Index>(k));
         break;
       }
@@ -111,7 +104,7 @@ void joint_angles_between(const sim::Model& model, std::span<const double> q0, s
     const sim::Body& b = model.bodies[static_cast<size_t>(i)];
     const auto a = static_cast<size_t>(b.qpos_adr);
     double angle = 0.0;
-    if (b.joint == sim::JointType::ball) angle = rotation_between(quat_at(q0, a), quat_at(q1, a)).norm();
+    if (b.joint == sim::JointType::ball) angle = sim::quat_between(quat_at(q0, a), quat_at(q1, a)).norm();
     if (b.joint == sim::JointType::hinge) angle = std::abs(q1[a] - q0[a]);
     out[static_cast<size_t>(i)] = angle;
   }

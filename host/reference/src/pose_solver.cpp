@@ -5,6 +5,7 @@
 #include <initializer_list>
 
 #include "rotations.hpp"
+#include "tonus/sim/joint_limits.hpp"
 
 namespace tonus::reference::detail {
 namespace {
@@ -155,7 +156,7 @@ void solve_frame(const Rig& rig, const Calibration& cal, const Neutral& neutral,
     const sim::Body& body = rig.body(b);
     const Quat base = carried(b);
     Quat j = (base.conjugate() * target).normalized();
-    out.clamped[idx(b)] = clamp_ball(j, body.limit);
+    out.clamped[idx(b)] = sim::clamp_ball(body.limit, j);
     world[idx(b)] = (base * j).normalized();
     const auto a = static_cast<std::size_t>(body.qpos_adr);
     out.qpos[a] = j.w();
@@ -165,7 +166,7 @@ void solve_frame(const Rig& rig, const Calibration& cal, const Neutral& neutral,
   };
   const auto set_hinge = [&](Bone b, double angle) {
     const sim::Body& body = rig.body(b);
-    out.clamped[idx(b)] = clamp_hinge(angle, body.limit);
+    out.clamped[idx(b)] = sim::clamp_hinge(body.limit, angle);
     world[idx(b)] = (carried(b) * Quat(Eigen::AngleAxisd(angle, body.hinge_axis))).normalized();
     out.qpos[static_cast<std::size_t>(body.qpos_adr)] = angle;
   };
@@ -250,7 +251,7 @@ void solve_frame(const Rig& rig, const Calibration& cal, const Neutral& neutral,
     frame_match(rig.dir[idx(l.upper)], hinge_in_upper, *u, axis, target);
     if (f) {
       double angle = hinge_towards(target, l.lower, *f);
-      clamp_hinge(angle, rig.body(l.lower).limit);
+      sim::clamp_hinge(rig.body(l.lower).limit, angle);
       const Vec3 end_in_upper =
           rig.body(l.lower).pos_in_parent +
           qip(l.lower) * (Quat(Eigen::AngleAxisd(angle, rig.body(l.lower).hinge_axis)) * rig.body(l.end).pos_in_parent);
@@ -293,7 +294,7 @@ void solve_frame(const Rig& rig, const Calibration& cal, const Neutral& neutral,
     const auto toes = segment(fr, kToes[k]);
     if (cal.foot_left[k]) {
       const Quat rel = clip_rotation(fr, leg.end).conjugate() * clip_rotation(fr, kToes[k]);
-      out.toe_matched_rad[k] = twist_about(rel, *cal.foot_left[k]);
+      out.toe_matched_rad[k] = sim::swing_twist(rel, *cal.foot_left[k]).twist_rad;
     } else {
       out.toe_matched_rad[k] = toes ? hinge_towards(world[idx(leg.end)], kToes[k], *toes) : neutral.toe_rad[k];
     }

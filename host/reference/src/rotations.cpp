@@ -41,41 +41,4 @@ double angle_about(const Vec3& axis, const Vec3& v0, const Vec3& v) {
   return std::atan2(axis.dot(a.cross(b)), a.dot(b));
 }
 
-double twist_about(const Quat& q_in, const Vec3& t) {
-  Quat q = q_in.normalized();
-  if (q.w() < 0.0) q.coeffs() = -q.coeffs();
-  return 2.0 * std::atan2(q.vec().dot(t), q.w());
-}
-
-bool clamp_ball(Quat& q, const sim::JointLimit& limit) {
-  if (!limit.enabled) return false;
-  q.normalize();
-  if (q.w() < 0.0) q.coeffs() = -q.coeffs();
-  const Vec3 t = limit.twist_axis.normalized();
-  // Twist: the rotation about t that q contains; swing: the rest, about an axis normal to t.
-  const double twist = twist_about(q, t);
-  const Quat twist_q(Eigen::AngleAxisd(twist, t));
-  const Quat swing_q = q * twist_q.conjugate();
-  const double swing_sin = swing_q.vec().norm();
-  const double swing = 2.0 * std::atan2(swing_sin, std::abs(swing_q.w()));
-  const double new_twist = std::clamp(twist, limit.lower_rad, limit.upper_rad);
-  const double new_swing = std::min(swing, limit.swing_max_rad);
-  if (new_twist == twist && new_swing == swing) return false;
-  Quat new_swing_q = swing_q;
-  if (new_swing != swing && swing_sin > kTiny) {
-    const Vec3 axis = (swing_q.w() < 0.0 ? -1.0 : 1.0) * swing_q.vec() / swing_sin;
-    new_swing_q = Quat(Eigen::AngleAxisd(new_swing, axis));
-  }
-  q = (new_swing_q * Quat(Eigen::AngleAxisd(new_twist, t))).normalized();
-  return true;
-}
-
-bool clamp_hinge(double& angle_rad, const sim::JointLimit& limit) {
-  if (!limit.enabled) return false;
-  const double c = std::clamp(angle_rad, limit.lower_rad, limit.upper_rad);
-  if (c == angle_rad) return false;
-  angle_rad = c;
-  return true;
-}
-
 }  // namespace tonus::reference::detail

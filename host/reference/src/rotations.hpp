@@ -1,6 +1,7 @@
 // Rotation helpers of the retargeting: a frame fixed by one exact and one
-// approximate direction, the least rotation that aims a bone, the signed
-// angle a hinge needs, and clamping into the model's joint ranges.
+// approximate direction, the least rotation that aims a bone, and the signed
+// angle a hinge needs. Clamping into the joint ranges is sim's
+// (tonus/sim/joint_limits.hpp).
 #pragma once
 
 #include "tonus/sim/model.hpp"
@@ -24,16 +25,5 @@ Quat aim(const Quat& from, const Vec3& r, const Vec3& d);
 // The angle about `axis` (unit) that turns v0 closest to v (both projected on
 // the plane normal to the axis); 0 when either projection vanishes.
 double angle_about(const Vec3& axis, const Vec3& v0, const Vec3& v);
-
-// The angle q turns about the unit axis t (the twist of a swing-twist decomposition), in [-pi, pi].
-double twist_about(const Quat& q, const Vec3& t);
-
-// Clamps a ball joint's quaternion into its swing cone (about the twist axis)
-// and twist range, by a swing-twist decomposition q = swing * twist, as the
-// physics core measures them. True when it had to move.
-bool clamp_ball(Quat& q, const sim::JointLimit& limit);
-
-// Clamps a hinge angle into its range. True when it had to move.
-bool clamp_hinge(double& angle_rad, const sim::JointLimit& limit);
 
 }  // namespace tonus::reference::detail

@@ -65,11 +65,8 @@ const sim::Data& Kinematics::at(const std::array<double, sim::kMaxQpos>& qpos) {
 }
 
 sim::Vec3 shape_centre(const sim::Model& m, const sim::Data& d, Bone b) {
-  for (int g = 0; g < m.ngeom; ++g) {
-    if (m.geoms[static_cast<std::size_t>(g)].body == static_cast<int>(sim::index(b)))
-      return d.xgeom[static_cast<std::size_t>(g)].pos;
-  }
-  return d.xbody[sim::index(b)].pos;
+  const int g = m.first_geom(static_cast<int>(sim::index(b)));
+  return g >= 0 ? d.xgeom[static_cast<std::size_t>(g)].pos : d.xbody[sim::index(b)].pos;
 }
 
 }  // namespace tonus::experiments

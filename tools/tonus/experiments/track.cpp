@@ -41,17 +41,10 @@ double hermite(double p0, double p1, double p2, double p3, double u) {
   return (2 * u3 - 3 * u2 + 1) * p1 + (u3 - 2 * u2 + u) * m1 + (-2 * u3 + 3 * u2) * p2 + (u3 - u2) * m2;
 }
 
-sim::Quat qexp(const Vec3& v) { return sim::quat_exp(v); }
-Vec3 qlog_between(const sim::Quat& a, const sim::Quat& b) {
-  sim::Quat d = a.conjugate() * b;
-  if (d.w() < 0.0) d.coeffs() = -d.coeffs();
-  return sim::quat_log(d.normalized());
-}
-
 sim::Quat bezier(const sim::Quat& q0, const sim::Quat& q1, const sim::Quat& q2, const sim::Quat& q3, double u) {
-  const Vec3 w1 = 0.5 * (qlog_between(q1, q2) - qlog_between(q1, q0));  // tangent at q1, per frame
-  const Vec3 w2 = 0.5 * (qlog_between(q2, q3) - qlog_between(q2, q1));
-  const sim::Quat b1 = q1 * qexp(w1 / 3.0), b2 = q2 * qexp(-w2 / 3.0);
+  const Vec3 w1 = 0.5 * (sim::quat_between(q1, q2) - sim::quat_between(q1, q0));  // tangent at q1, per frame
+  const Vec3 w2 = 0.5 * (sim::quat_between(q2, q3) - sim::quat_between(q2, q1));
+  const sim::Quat b1 = q1 * sim::quat_exp(w1 / 3.0), b2 = q2 * sim::quat_exp(-w2 / 3.0);
   const sim::Quat a = q1.slerp(u, b1), b = b1.slerp(u, b2), c = b2.slerp(u, q2);
   const sim::Quat d = a.slerp(u, b), e = b.slerp(u, c);
   return d.slerp(u, e).normalized();

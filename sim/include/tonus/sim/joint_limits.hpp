@@ -20,6 +20,13 @@ struct SwingTwist {
 };
 SwingTwist swing_twist(const Quat& q, const Vec3& t);
 
+// One joint onto its range (nothing when the limit is disabled or the value
+// is not finite). A ball joint's swing goes into the cone about the twist
+// axis, keeping its direction, and its twist into [lower, upper]. True when
+// it had to move.
+bool clamp_ball(const JointLimit& limit, Quat& q);
+bool clamp_hinge(const JointLimit& limit, double& angle_rad);
+
 // Moves every limited joint of `qpos` (the model's layout) onto its range:
 // hinge angles into [lower, upper]; ball joints' swing into the cone and their
 // twist into [lower, upper], keeping the swing's direction. Returns how many

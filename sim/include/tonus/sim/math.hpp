@@ -55,6 +55,9 @@ inline Vec3 quat_log(const Quat& q) {
   return (2.0 * std::atan2(s, w) / s) * v;
 }
 
+// The rotation vector taking a to b in a's frame (the short way round).
+inline Vec3 quat_between(const Quat& a, const Quat& b) { return quat_log((a.conjugate() * b).normalized()); }
+
 // Right-multiplied integration, as MuJoCo's mju_quatIntegrate: the angular
 // velocity is expressed in the rotating (local) frame.
 inline Quat quat_integrate(const Quat& q, const Vec3& omega_local, double dt_s) {

@@ -166,6 +166,8 @@ struct Model {
   [[nodiscard]] double total_mass_kg() const;
   // Index of the body named `name`, or -1.
   [[nodiscard]] int body_index(std::string_view name) const;
+  // Index of the first geom on `body`, or -1 (the humanoid has one per body).
+  [[nodiscard]] int first_geom(int body) const;
 };
 
 }  // namespace tonus::sim

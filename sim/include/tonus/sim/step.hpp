@@ -43,7 +43,8 @@ void integrate_positions(const Model& model, std::span<double> qpos, std::span<c
 // Energy and momentum of the articulation and the objects (needs forward_kinematics).
 struct Energy {
   double kinetic_j = 0.0;
-  double potential_j = 0.0;  // m g h relative to the world origin, with the model's gravity
+  double potential_j = 0.0;        // m g h relative to the world origin, with the model's gravity
+  double objects_kinetic_j = 0.0;  // the objects' share of kinetic_j
   [[nodiscard]] double total_j() const { return kinetic_j + potential_j; }
 };
 Energy energy(const Model& model, const Data& data);
