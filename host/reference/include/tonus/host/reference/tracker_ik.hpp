@@ -1,0 +1,177 @@
+// Full-body poses from 3 trackers (head + hands) or 6 (+ waist + feet), in
+// the spirit of Final IK's VRIK: analytic, a few microseconds, no allocation.
+//
+// Per frame:
+//   1. Each tracker's sample is checked (finite, unit, plausible) and turned
+//      into its bone's pose through the calibration offset. A lost tracker is
+//      held, then eased to a neutral pose; a returning one is blended back.
+//   2. Trunk. 3 points: the body's heading from the head's facing and the
+//      hands; the head's tilt shared out down the neck, chest, spine and
+//      pelvis; the pelvis placed where that chain puts the head exactly on its
+//      tracker, so crouching and leaning come out of the head's height.
+//      6 points: the pelvis from the waist tracker and the spine bent to
+//      reach the head (FABRIK on three links).
+//   3. Arms: the clavicle raised toward a high or far hand; two-bone arms that
+//      put the wrist on the tracker, the elbow on the side away from where the
+//      hand points (least wrist bend), or toward an elbow tracker.
+//   4. Legs: 6 points, two-bone legs to the foot trackers, knees toward the
+//      feet's facing (or knee trackers). 3 points, procedural steps: each foot
+//      stays planted until the pelvis has moved or turned past a threshold,
+//      then steps, one at a time, toward where the moving pelvis will need it.
+//   5. Every joint is put into the humanoid's range (sim/joint_limits.hpp);
+//      quaternions stay in the previous frame's hemisphere.
+//
+// The humanoid must be sim/humanoid.hpp's, built for the performer
+// (calibrated_spec) so its bones match the calibration.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+
+#include "tonus/host/reference/calibration.hpp"
+#include "tonus/host/reference/trackers.hpp"
+#include "tonus/sim/capacity.hpp"
+#include "tonus/sim/model.hpp"
+
+namespace tonus::reference {
+
+struct IkOptions {
+  // Trunk (3 points): the share of the head's rotation (relative to the
+  // body's heading) each trunk bone takes, in world terms, pelvis to neck.
+  double pelvis_share = 0.0;
+  double spine_share = 0.12;
+  double chest_share = 0.25;
+  double neck_share = 0.6;
+  double hands_heading_weight = 0.3;  // the hands' say in the body's heading, against the head's 1
+  // Arms.
+  double clavicle_share = 0.08;        // of the swing that would point the clavicle at the hand
+  double clavicle_raise_share = 0.25;  // added in proportion to how far above the shoulder the hand is
+  double default_pole_weight = 0.25;   // elbows: the anatomical pole (down, back) against the hand's
+  // Steps (3 points).
+  double step_threshold_m = 0.12;  // a planted foot further than this from its place under the hip steps
+  double step_turn_rad = 0.6;      // ... or turned further than this from the pelvis's heading
+  double step_time_s = 0.45;       // one step's swing at standing pace
+  double step_time_min_s = 0.3;    // when walking fast
+  double step_lift_m = 0.08;       // swing height
+  // A foot lands this far ahead of the moving pelvis. Half a stance (about
+  // 0.33 s) would make a walk's stride, but 3 points do not say which foot
+  // stands, and a stride in the wrong phase is a step length off: shorter
+  // steps are the better guess (measured on real walks, docs/reference.md).
+  double step_lead_s = 0.1;
+  double velocity_time_constant_s = 0.1;  // smoothing of the pelvis's speed
+  // Lost trackers.
+  double hold_s = 0.25;    // a lost tracker is held this long ...
+  double ease_s = 0.5;     // ... then eased to its neutral over this
+  double recover_s = 0.2;  // a tracker that comes back is blended in over this
+  // Plausibility: a hand further than this times the arm's reach from the
+  // shoulder, or a head this far above the calibrated height, is flagged.
+  double implausible_reach_factor = 1.6;
+};
+
+// What a frame's solve met (bits of IkOutput::flags).
+enum IkFlag : std::uint32_t {
+  kIkNoHead = 1u << 0,           // the head was never seen: the rest pose, standing
+  kIkTrackerInvalid = 1u << 1,   // a sample was not finite or not a rotation, and was ignored
+  kIkTrackerHeld = 1u << 2,      // a lost tracker is being held
+  kIkTrackerEased = 1u << 3,     // a lost tracker is being eased to its neutral
+  kIkHandUnreachable = 1u << 4,  // a wrist missed its target by over 1 mm: beyond the arm, or its joint ranges
+  kIkFootUnreachable = 1u << 5,  // the same for an ankle
+  kIkHeadMissed = 1u << 6,       // the spine could not reach the head (6 points)
+  kIkImplausible = 1u << 7,      // a hand far beyond reach, or the head far above the body's height
+  kIkHandsSwapped = 1u << 8,     // the left hand is on the body's right and the right on its left
+  kIkJointClamped = 1u << 9,     // a joint was put into its range
+  kIkBadTime = 1u << 10,         // the frame's time went backwards or was not finite (dt taken as 0)
+  kIkStepping = 1u << 11,        // a foot is in the air (3 points)
+};
+
+// How each tracker was used this frame.
+enum class TrackerUse : std::uint8_t { unused, live, held, easing, neutral, recovering };
+
+struct IkOutput {
+  std::array<double, sim::kMaxQpos> qpos{};  // the humanoid's configuration (its model's layout)
+  int nq = 0;
+  std::uint32_t flags = 0;
+  std::array<TrackerUse, kTrackerCount> use{};
+  int joints_clamped = 0;
+  // Distance from each wrist and the head joint to its target after the
+  // solve (0 when reached), m.
+  std::array<double, 2> hand_error_m{};
+  double head_error_m = 0.0;
+  std::array<double, 2> foot_error_m{};
+  // World positions of the joints, from the solved configuration (Bone order).
+  std::array<sim::Vec3, sim::kBoneCount> joint_pos{};
+};
+
+// Counters over the solver's life.
+struct IkStats {
+  std::uint64_t frames = 0;
+  std::uint64_t invalid_samples = 0;
+  std::uint64_t implausible_frames = 0;
+  std::uint64_t swapped_frames = 0;
+  std::uint64_t steps = 0;
+  std::uint64_t clamped_frames = 0;
+};
+
+// Immutable: the humanoid's bones, the calibration and the options.
+struct IkModel {
+  std::array<sim::Vec3, sim::kBoneCount> offset{};    // pos_in_parent, rest frames parallel to the world
+  std::array<sim::Vec3, sim::kBoneCount> rest_dir{};  // unit, towards the chain child (end bones: the twist axis)
+  std::array<sim::Vec3, sim::kBoneCount> hinge_axis{};
+  std::array<sim::JointLimit, sim::kBoneCount> limit{};
+  std::array<sim::JointType, sim::kBoneCount> joint{};
+  std::array<int, sim::kBoneCount> qpos_adr{};
+  std::array<double, sim::kMaxQpos> qpos0{};  // the rest configuration
+  int nq = 0;
+  std::array<double, 2> upper_arm_m{}, forearm_m{}, thigh_m{}, shank_m{};  // [left, right]
+  std::array<sim::Vec3, 2> ankle_in_hips{};  // the ankles' rest position in the pelvis's frame
+  double ankle_height_m = 0.0;               // the ankle joint above the floor, standing
+  double stature_m = 0.0;
+  BodyCalibration calibration;
+  IkOptions options;
+};
+
+// Mutable: what the solver carries from frame to frame.
+struct IkState {
+  bool started = false;
+  double time_s = 0.0;
+  struct Track {
+    TrackerPose target;  // the bone's last valid pose
+    TrackerPose shown;   // the pose used last frame (what recovery blends from)
+    TrackerPose held;    // the pose shown when the tracker was lost (what easing starts from)
+    double lost_s = 0.0;
+    double recover_left_s = 0.0;
+    bool seen = false;
+  };
+  std::array<Track, kTrackerCount> track{};
+  double body_yaw_rad = 0.0;
+  sim::Vec3 last_pelvis = sim::Vec3::Zero();
+  sim::Vec3 pelvis_velocity = sim::Vec3::Zero();
+  struct Foot {
+    sim::Vec3 planted = sim::Vec3::Zero();  // ankle joint position
+    double yaw_rad = 0.0;
+    sim::Vec3 from = sim::Vec3::Zero();
+    double from_yaw_rad = 0.0;
+    double phase = -1.0;  // < 0: planted; [0, 1): stepping
+    double duration_s = 0.0;
+  };
+  std::array<Foot, 2> foot{};
+  std::array<double, sim::kMaxQpos> last_qpos{};
+  IkStats stats;
+};
+
+struct IkCreated {
+  std::optional<IkModel> model;
+  std::string error;
+};
+
+// Checks that `humanoid` is sim/humanoid.hpp's and the options are sane.
+IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calibration, const IkOptions& options = {});
+
+// Solves one frame. Never throws, never allocates, never writes a NaN.
+void solve_ik(const IkModel& model, IkState& state, const TrackerFrame& frame, IkOutput& out);
+
+}  // namespace tonus::reference

@@ -1,0 +1,108 @@
+#include "foot_steps.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "body_frames.hpp"
+
+namespace tonus::reference::detail {
+namespace {
+
+double wrap(double a) { return std::remainder(a, 2.0 * std::numbers::pi); }
+
+// Minimum-jerk progress: zero speed and acceleration at both ends.
+double min_jerk(double t) {
+  t = std::clamp(t, 0.0, 1.0);
+  return t * t * t * (10.0 + t * (-15.0 + 6.0 * t));
+}
+
+sim::Vec3 ideal_ankle(const IkModel& m, const sim::Vec3& pelvis, double yaw, std::size_t side) {
+  const sim::Vec3 local = horizontal(m.ankle_in_hips[side]);
+  sim::Vec3 p = horizontal(pelvis) + yaw_quat(yaw) * local;
+  p.z() = m.ankle_height_m;
+  return p;
+}
+
+}  // namespace
+
+void plant_feet(const IkModel& model, IkState& state, const sim::Vec3& pelvis, double pelvis_yaw_rad) {
+  for (std::size_t s = 0; s < 2; ++s) {
+    IkState::Foot& f = state.foot[s];
+    f.planted = ideal_ankle(model, pelvis, pelvis_yaw_rad, s);
+    f.yaw_rad = pelvis_yaw_rad;
+    f.phase = -1.0;
+  }
+}
+
+bool advance_feet(const IkModel& model, IkState& state, const sim::Vec3& pelvis, double pelvis_yaw_rad, double dt_s,
+                  const std::array<bool, 2>& tracked, std::array<FootTarget, 2>& out) {
+  const IkOptions& o = model.options;
+  const sim::Vec3 v = horizontal(state.pelvis_velocity);
+  const double speed = v.norm();
+  // A foot lands ahead of its place under the hip by what the pelvis covers
+  // in half a stance, and lifts when it has fallen as far behind: a walk's
+  // symmetric stride. Standing, a small threshold keeps the stance tidy.
+  std::array<sim::Vec3, 2> under{}, want{};
+  for (std::size_t s = 0; s < 2; ++s) {
+    under[s] = ideal_ankle(model, pelvis, pelvis_yaw_rad, s);
+    want[s] = under[s] + o.step_lead_s * v;
+  }
+  const double reach_out = std::max(o.step_threshold_m, o.step_lead_s * speed);
+
+  bool started = false;
+  bool any_stepping = false;
+  for (std::size_t s = 0; s < 2; ++s) {
+    IkState::Foot& f = state.foot[s];
+    if (f.phase < 0.0) continue;
+    f.phase += dt_s / std::max(f.duration_s, 1e-3);
+    if (f.phase >= 1.0) {
+      f.planted = want[s];
+      f.yaw_rad = pelvis_yaw_rad;
+      f.phase = -1.0;
+    } else {
+      any_stepping = true;
+    }
+  }
+  if (!any_stepping) {
+    // The foot furthest out of place (distance or turn, each over its
+    // threshold) steps, if either is out.
+    double worst = 1.0;
+    int pick = -1;
+    for (std::size_t s = 0; s < 2; ++s) {
+      const IkState::Foot& f = state.foot[s];
+      if (tracked[s]) continue;
+      const double off = (horizontal(f.planted - under[s])).norm() / reach_out;
+      const double turn = std::abs(wrap(f.yaw_rad - pelvis_yaw_rad)) / o.step_turn_rad;
+      const double score = std::max(off, turn);
+      if (score > worst) {
+        worst = score;
+        pick = static_cast<int>(s);
+      }
+    }
+    if (pick >= 0) {
+      IkState::Foot& f = state.foot[static_cast<std::size_t>(pick)];
+      f.from = f.planted;
+      f.from_yaw_rad = f.yaw_rad;
+      f.phase = 0.0;
+      const double fast = std::clamp(speed / 1.5, 0.0, 1.0);
+      f.duration_s = o.step_time_s - fast * (o.step_time_s - o.step_time_min_s);
+      started = true;
+    }
+  }
+  for (std::size_t s = 0; s < 2; ++s) {
+    const IkState::Foot& f = state.foot[s];
+    if (f.phase < 0.0) {
+      out[s] = {f.planted, f.yaw_rad};
+      continue;
+    }
+    const double k = min_jerk(f.phase);
+    sim::Vec3 p = f.from + k * (want[s] - f.from);
+    const double arc = 16.0 * f.phase * f.phase * (1.0 - f.phase) * (1.0 - f.phase);  // 1 at mid-step, flat ends
+    p.z() += o.step_lift_m * arc;
+    out[s] = {p, f.from_yaw_rad + k * wrap(pelvis_yaw_rad - f.from_yaw_rad)};
+  }
+  return started;
+}
+
+}  // namespace tonus::reference::detail

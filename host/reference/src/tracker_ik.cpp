@@ -1,0 +1,509 @@
+#include "tonus/host/reference/tracker_ik.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "body_frames.hpp"
+#include "foot_steps.hpp"
+#include "rig.hpp"
+#include "rotations.hpp"
+#include "tonus/sim/joint_limits.hpp"
+#include "tracker_input.hpp"
+#include "two_bone.hpp"
+
+namespace tonus::reference {
+namespace {
+
+using detail::BodyFrames;
+using detail::horizontal;
+using detail::yaw_quat;
+using sim::Bone;
+using sim::Quat;
+using sim::Vec3;
+
+constexpr std::size_t bi(Bone b) { return sim::index(b); }
+constexpr std::array<Bone, 2> kUpperArm{Bone::LeftUpperArm, Bone::RightUpperArm};
+constexpr std::array<Bone, 2> kClavicle{Bone::LeftShoulder, Bone::RightShoulder};
+constexpr std::array<Bone, 2> kThigh{Bone::LeftUpperLeg, Bone::RightUpperLeg};
+constexpr std::array<Tracker, 2> kHand{Tracker::left_hand, Tracker::right_hand};
+constexpr std::array<Tracker, 2> kFootTracker{Tracker::left_foot, Tracker::right_foot};
+constexpr std::array<Tracker, 2> kElbow{Tracker::left_elbow, Tracker::right_elbow};
+constexpr std::array<Tracker, 2> kKnee{Tracker::left_knee, Tracker::right_knee};
+constexpr int kSpineIterations = 24;
+constexpr int kClavicleBisections = 40;
+constexpr int kTwistCorrections = 3;
+constexpr double kReachedTolerance_m = 1e-3;
+constexpr double kTwistMargin_rad = 0.05;
+
+double yaw_of(const Vec3& forward, double fallback) {
+  const Vec3 f = horizontal(forward);
+  return f.norm() > 1e-6 ? std::atan2(f.y(), f.x()) : fallback;
+}
+
+// The solve's working set: world rotations and positions, the joints' local
+// values (ball: rotation, hinge: angle) as they are settled into their ranges.
+struct Work {
+  BodyFrames f;
+  std::array<Quat, sim::kBoneCount> local{};
+  std::array<double, sim::kBoneCount> angle{};
+  int clamped = 0;
+};
+
+// Sets bone b's world rotation to `world` (ball joint): its local rotation
+// clamped into range, the world rotation recomputed from it.
+bool settle_ball(const IkModel& m, Work& w, Bone b, const Quat& world) {
+  const std::size_t i = bi(b);
+  const std::size_t p = bi(*sim::kBones[i].parent);
+  Quat q = (w.f.rot[p].conjugate() * world).normalized();
+  const bool clamped = sim::clamp_ball(m.limit[i], q);
+  if (clamped) ++w.clamped;
+  w.local[i] = q;
+  w.f.rot[i] = (w.f.rot[p] * q).normalized();
+  return clamped;
+}
+
+void settle_hinge(const IkModel& m, Work& w, Bone b, double angle_rad) {
+  const std::size_t i = bi(b);
+  const std::size_t p = bi(*sim::kBones[i].parent);
+  if (sim::clamp_hinge(m.limit[i], angle_rad)) ++w.clamped;
+  w.angle[i] = angle_rad;
+  w.local[i] = Quat(Eigen::AngleAxisd(angle_rad, m.hinge_axis[i]));
+  w.f.rot[i] = (w.f.rot[p] * w.local[i]).normalized();
+}
+
+Vec3 joint_of(const Work& w, const IkModel& m, Bone b) {
+  const std::size_t i = bi(b);
+  const std::size_t p = bi(*sim::kBones[i].parent);
+  return w.f.pos[p] + w.f.rot[p] * m.offset[i];
+}
+
+// FABRIK on the spine's three links (spine, chest, neck) from the fixed
+// spine joint to the head joint. `pts` starts as the current chain.
+bool reach_head(std::array<Vec3, 4>& pts, const std::array<double, 3>& len, const Vec3& target) {
+  const Vec3 base = pts[0];
+  if ((target - base).norm() >= len[0] + len[1] + len[2]) {
+    const Vec3 d = (target - base).normalized();
+    for (std::size_t k = 1; k < 4; ++k) pts[k] = pts[k - 1] + len[k - 1] * d;
+    return false;
+  }
+  // A fixed number of sweeps, no early exit: the result is then a smooth
+  // function of the targets (a tolerance test would make it jump).
+  for (int it = 0; it < kSpineIterations; ++it) {
+    pts[3] = target;
+    for (std::size_t k = 3; k-- > 0;) pts[k] = pts[k + 1] + len[k] * (pts[k] - pts[k + 1]).normalized();
+    pts[0] = base;
+    for (std::size_t k = 1; k < 4; ++k) pts[k] = pts[k - 1] + len[k - 1] * (pts[k] - pts[k - 1]).normalized();
+  }
+  return true;
+}
+
+}  // namespace
+
+IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calibration, const IkOptions& options) {
+  IkCreated c;
+  detail::Rig rig;
+  if (std::string e = detail::make_rig(humanoid, rig); !e.empty()) {
+    c.error = "tracker IK: " + e;
+    return c;
+  }
+  for (std::size_t i = 0; i < sim::kBoneCount; ++i) {
+    if (!humanoid.bodies[i].quat_in_parent.isApprox(Quat::Identity(), 1e-9)) {
+      c.error = "tracker IK: the humanoid's rest frames must be parallel to the world (body " +
+                std::string(sim::kBones[i].name) + " is turned)";
+      return c;
+    }
+  }
+  const IkOptions& o = options;
+  const bool times_ok = o.step_time_s > 0.0 && o.step_time_min_s > 0.0 && o.step_time_min_s <= o.step_time_s &&
+                        o.hold_s >= 0.0 && o.ease_s >= 0.0 && o.recover_s >= 0.0 && o.step_lead_s >= 0.0 &&
+                        o.velocity_time_constant_s >= 0.0;
+  const bool sizes_ok =
+      o.step_threshold_m > 0.0 && o.step_turn_rad > 0.0 && o.step_lift_m >= 0.0 && o.implausible_reach_factor > 1.0;
+  const bool shares_ok = o.pelvis_share >= 0.0 && o.spine_share >= 0.0 && o.chest_share >= 0.0 && o.neck_share >= 0.0 &&
+                         o.pelvis_share <= 1.0 && o.spine_share <= 1.0 && o.chest_share <= 1.0 && o.neck_share <= 1.0 &&
+                         o.hands_heading_weight >= 0.0 && o.clavicle_share >= 0.0 && o.clavicle_raise_share >= 0.0 &&
+                         o.default_pole_weight >= 0.0;
+  if (!(times_ok && sizes_ok && shares_ok)) {
+    c.error = "tracker IK: an option is out of range (times and lengths must be positive, shares in [0, 1])";
+    return c;
+  }
+  if (!(calibration.height_m > 0.0) || !std::isfinite(calibration.height_m)) {
+    c.error = "tracker IK: the calibration has no height";
+    return c;
+  }
+  if (!calibration.offset[index(Tracker::head)].valid) {
+    c.error = "tracker IK: the calibration has no head tracker offset";
+    return c;
+  }
+  IkModel m;
+  for (std::size_t i = 0; i < sim::kBoneCount; ++i) {
+    const sim::Body& b = humanoid.bodies[i];
+    m.offset[i] = b.pos_in_parent;
+    m.rest_dir[i] = rig.dir[i];
+    m.hinge_axis[i] = b.hinge_axis;
+    m.limit[i] = b.limit;
+    m.qpos_adr[i] = b.qpos_adr;
+    m.joint[i] = b.joint;
+  }
+  for (int i = 0; i < humanoid.nq; ++i)
+    m.qpos0[static_cast<std::size_t>(i)] = humanoid.qpos0[static_cast<std::size_t>(i)];
+  m.nq = humanoid.nq;
+  for (std::size_t s = 0; s < 2; ++s) {
+    m.upper_arm_m[s] = rig.length[bi(kUpperArm[s])];
+    m.forearm_m[s] = rig.length[bi(kUpperArm[s]) + 1];
+    m.thigh_m[s] = rig.length[bi(kThigh[s])];
+    m.shank_m[s] = rig.length[bi(kThigh[s]) + 1];
+    m.ankle_in_hips[s] = m.offset[bi(kThigh[s])] + m.offset[bi(kThigh[s]) + 1] + m.offset[bi(kThigh[s]) + 2];
+  }
+  m.ankle_height_m = m.offset[0].z() + 0.5 * (m.ankle_in_hips[0].z() + m.ankle_in_hips[1].z());
+  m.stature_m = calibration.height_m;
+  m.calibration = calibration;
+  m.options = options;
+  c.model = m;
+  return c;
+}
+
+void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput& out) {
+  const IkOptions& o = m.options;
+  out.flags = 0;
+  out.nq = m.nq;
+  ++st.stats.frames;
+
+  double dt = 0.0;
+  if (!std::isfinite(frame.time_s)) {
+    out.flags |= kIkBadTime;
+  } else if (st.started) {
+    dt = frame.time_s - st.time_s;
+    if (dt < 0.0) {
+      out.flags |= kIkBadTime;
+      dt = 0.0;
+    }
+    dt = std::min(dt, 0.1);  // a long gap is not a reason to run steps off
+    st.time_s = frame.time_s;
+  } else {
+    st.time_s = frame.time_s;
+  }
+
+  // 1. Samples.
+  for (std::size_t t = 0; t < kTrackerCount; ++t) {
+    out.use[t] = TrackerUse::unused;
+    if (!m.calibration.offset[t].valid) continue;
+    if (!detail::read_sample(frame.pose[t], m.calibration.offset[t], dt, o, st.track[t])) {
+      out.flags |= kIkTrackerInvalid;
+      ++st.stats.invalid_samples;
+    }
+  }
+  IkState::Track& head_track = st.track[index(Tracker::head)];
+  if (!head_track.seen) {
+    // Nothing to follow yet: the rest pose, standing at the origin.
+    out.flags |= kIkNoHead;
+    out.qpos = m.qpos0;
+    out.qpos[2] = m.offset[0].z();
+    out.head_error_m = 0.0;
+    out.hand_error_m = {0.0, 0.0};
+    out.foot_error_m = {0.0, 0.0};
+    return;
+  }
+  // A lost head has no neutral: it is held where it was.
+  const TrackerPose head = detail::effective_pose(head_track.held.valid ? head_track.held : head_track.shown, dt, o,
+                                                  head_track, out.use[index(Tracker::head)]);
+
+  // 2. Heading: the head's facing (its forward, or its up when it looks down),
+  // pulled toward the facing the hands' line gives.
+  Work w;
+  const Vec3 head_fwd = horizontal(head.rot * Vec3::UnitX()) + 0.5 * horizontal(head.rot * Vec3::UnitZ());
+  Vec3 facing = head_fwd.norm() > 1e-9 ? Vec3(head_fwd.normalized())
+                                       : Vec3(std::cos(st.body_yaw_rad), std::sin(st.body_yaw_rad), 0.0);
+  const IkState::Track& lh = st.track[index(Tracker::left_hand)];
+  const IkState::Track& rh = st.track[index(Tracker::right_hand)];
+  if (lh.seen && rh.seen) {
+    const Vec3 l = lh.target.valid ? lh.target.pos_m : lh.shown.pos_m;
+    const Vec3 r = rh.target.valid ? rh.target.pos_m : rh.shown.pos_m;
+    const Vec3 across = horizontal(l - r);
+    const double spread = across.norm();
+    if (spread > 1e-3) {
+      const Vec3 hands_fwd = across.cross(Vec3::UnitZ()) / spread;
+      const double agree = std::max(0.0, hands_fwd.dot(facing));
+      facing += o.hands_heading_weight * std::min(1.0, spread / 0.3) * agree * hands_fwd;
+    }
+  }
+  const double yaw = yaw_of(facing, st.body_yaw_rad);
+  st.body_yaw_rad = yaw;
+  const Quat heading = yaw_quat(yaw);
+
+  // 3. Trunk: each bone takes its share of the head's turn from the heading.
+  const Quat head_rel = (heading.conjugate() * head.rot).normalized();
+  const auto share = [&](double s) { return (heading * Quat::Identity().slerp(s, head_rel)).normalized(); };
+  w.f.rot[bi(Bone::Hips)] = share(o.pelvis_share);
+  settle_ball(m, w, Bone::Spine, share(o.spine_share));
+  settle_ball(m, w, Bone::Chest, share(o.chest_share));
+  settle_ball(m, w, Bone::Neck, share(o.neck_share));
+  settle_ball(m, w, Bone::Head, head.rot);
+  // The pelvis that puts the head joint exactly on its target.
+  Vec3 pelvis = head.pos_m;
+  for (const Bone b : {Bone::Head, Bone::Neck, Bone::Chest, Bone::Spine}) {
+    pelvis -= w.f.rot[bi(*sim::info(b).parent)] * m.offset[bi(b)];
+  }
+  w.f.pos[0] = pelvis;
+
+  // 6 points: the pelvis from the waist tracker (eased toward the estimate
+  // when lost), the spine bent to reach the head.
+  IkState::Track& waist = st.track[index(Tracker::waist)];
+  if (m.calibration.offset[index(Tracker::waist)].valid && waist.seen) {
+    const TrackerPose estimate{pelvis, w.f.rot[0], true};
+    const TrackerPose hips = detail::effective_pose(estimate, dt, o, waist, out.use[index(Tracker::waist)]);
+    w.f.pos[0] = hips.pos_m;
+    w.f.rot[0] = hips.rot;
+    std::array<Vec3, 4> pts{};
+    pts[0] = hips.pos_m + hips.rot * m.offset[bi(Bone::Spine)];
+    // Start from the 3-point chain's shape, carried to the new pelvis.
+    const Quat carry = (hips.rot * share(o.pelvis_share).conjugate()).normalized();
+    const std::array<Bone, 3> links{Bone::Spine, Bone::Chest, Bone::Neck};
+    std::array<double, 3> len{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Vec3 seg = m.offset[bi(links[k]) + 1];
+      len[k] = seg.norm();
+      pts[k + 1] = pts[k] + carry * (w.f.rot[bi(links[k])] * seg);
+    }
+    const bool reachable = reach_head(pts, len, head.pos_m);
+    std::array<Quat, 3> aimed{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Quat start = (carry * w.f.rot[bi(links[k])]).normalized();
+      aimed[k] = detail::aim(start, m.rest_dir[bi(links[k])], pts[k + 1] - pts[k]);
+    }
+    for (std::size_t k = 0; k < 3; ++k) settle_ball(m, w, links[k], aimed[k]);
+    settle_ball(m, w, Bone::Head, head.rot);
+    if (!reachable) out.flags |= kIkHeadMissed;
+  }
+  const Vec3 pelvis_now = w.f.pos[0];
+  detail::place_bones(m.offset, pelvis_now, w.f);  // trunk joints (limbs are redone below)
+
+  // Plausibility of the hands against the body.
+  const Quat body_yaw = yaw_quat(yaw);
+  {
+    const Vec3 l = body_yaw.conjugate() * (lh.target.pos_m - w.f.pos[bi(Bone::Chest)]);
+    const Vec3 r = body_yaw.conjugate() * (rh.target.pos_m - w.f.pos[bi(Bone::Chest)]);
+    if (lh.seen && rh.seen && lh.target.valid && rh.target.valid && l.y() < -0.15 && r.y() > 0.15) {
+      out.flags |= kIkHandsSwapped;
+      ++st.stats.swapped_frames;
+    }
+  }
+
+  // 4. Arms.
+  for (std::size_t s = 0; s < 2; ++s) {
+    const Bone clav = kClavicle[s];
+    const Bone upper = kUpperArm[s];
+    const Bone fore = static_cast<Bone>(bi(upper) + 1);
+    const Bone hand = static_cast<Bone>(bi(upper) + 2);
+    const double reach = m.upper_arm_m[s] + m.forearm_m[s];
+    const Quat chest = w.f.rot[bi(Bone::Chest)];
+    const Vec3 clav_pos = w.f.pos[bi(clav)];
+    // Neutral: hanging at the side, the hand in line with the forearm.
+    const Vec3 rest_arm = m.rest_dir[bi(upper)];
+    const Vec3 down = (body_yaw * Vec3(0.0, 0.15 * rest_arm.y(), -1.0)).normalized();
+    const Quat hang = (body_yaw * Quat::FromTwoVectors(rest_arm, body_yaw.conjugate() * down)).normalized();
+    const Vec3 shoulder_rest = clav_pos + chest * m.offset[bi(upper)];
+    const TrackerPose neutral{shoulder_rest + reach * down, hang, true};
+    TrackerPose target = neutral;
+    IkState::Track& tr = st.track[index(kHand[s])];
+    if (m.calibration.offset[index(kHand[s])].valid) {
+      target = detail::effective_pose(neutral, dt, o, tr, out.use[index(kHand[s])]);
+    }
+    if ((target.pos_m - shoulder_rest).norm() > o.implausible_reach_factor * reach) out.flags |= kIkImplausible;
+
+    // Clavicle: a share of the turn that would point it at the hand, more for
+    // a raised hand, and as much as the reach needs (bisection).
+    const Vec3 to_hand = chest.conjugate() * (target.pos_m - clav_pos);
+    const Vec3 clav_dir = m.offset[bi(upper)].normalized();
+    const Quat full = to_hand.norm() > 1e-9 ? Quat::FromTwoVectors(clav_dir, to_hand) : Quat::Identity();
+    const double raise = std::max(0.0, to_hand.normalized().z());
+    double k = std::min(1.0, o.clavicle_share + o.clavicle_raise_share * raise);
+    const auto shoulder_at = [&](double kk, Quat& local) {
+      local = Quat::Identity().slerp(kk, full);
+      sim::clamp_ball(m.limit[bi(clav)], local);
+      return Vec3(clav_pos + chest * (local * m.offset[bi(upper)]));
+    };
+    Quat clav_local;
+    if ((target.pos_m - shoulder_at(k, clav_local)).norm() > reach) {
+      double lo = k, hi = 1.0;
+      for (int it = 0; it < kClavicleBisections; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        Quat tmp;
+        ((target.pos_m - shoulder_at(mid, tmp)).norm() > reach ? lo : hi) = mid;
+      }
+      k = hi;
+    }
+    shoulder_at(k, clav_local);
+    settle_ball(m, w, clav, (chest * clav_local).normalized());
+    const Vec3 shoulder = joint_of(w, m, upper);
+
+    // Elbow: away from where the hand points (the least wrist bend), with
+    // some of the anatomical pole (down, back, out); an elbow tracker wins.
+    const Vec3 hand_dir = target.rot * m.rest_dir[bi(hand)];
+    const Vec3 anatomic = chest * Vec3(-0.4, 0.3 * rest_arm.y(), -1.0);
+    Vec3 pole = -hand_dir + o.default_pole_weight * anatomic.normalized();
+    IkState::Track& et = st.track[index(kElbow[s])];
+    if (m.calibration.offset[index(kElbow[s])].valid && et.seen) {
+      const TrackerPose e = detail::effective_pose(TrackerPose{shoulder + pole, Quat::Identity(), true}, dt, o, et,
+                                                   out.use[index(kElbow[s])]);
+      pole = e.pos_m - shoulder;
+    }
+    detail::TwoBoneLimb limb{m.rest_dir[bi(upper)], m.rest_dir[bi(fore)], m.hinge_axis[bi(fore)], m.upper_arm_m[s],
+                             m.forearm_m[s]};
+    detail::TwoBoneSolution sol = detail::solve_two_bone(limb, shoulder, target.pos_m, pole, anatomic);
+    // An elbow the upper arm cannot twist to is turned about the shoulder-wrist
+    // line until it can (the twist follows that turn almost one to one).
+    const Vec3 line = target.pos_m - shoulder;
+    for (int it = 0; it < kTwistCorrections && line.norm() > 1e-6; ++it) {
+      const Quat local = (w.f.rot[bi(clav)].conjugate() * sol.upper).normalized();
+      const sim::JointLimit& lim = m.limit[bi(upper)];
+      const double twist = sim::swing_twist(local, lim.twist_axis).twist_rad;
+      const double excess =
+          twist - std::clamp(twist, lim.lower_rad + kTwistMargin_rad, lim.upper_rad - kTwistMargin_rad);
+      if (excess == 0.0) break;
+      pole = Eigen::AngleAxisd(-excess, line.normalized()) * pole;
+      sol = detail::solve_two_bone(limb, shoulder, target.pos_m, pole, anatomic);
+    }
+    w.f.pos[bi(upper)] = shoulder;
+    double angle = sol.hinge_rad;
+    if (settle_ball(m, w, upper, sol.upper)) {
+      // The shoulder was clamped: re-aim the forearm from where the elbow is.
+      const Vec3 elbow = shoulder + w.f.rot[bi(upper)] * m.offset[bi(fore)];
+      angle = detail::angle_about(m.hinge_axis[bi(fore)], m.rest_dir[bi(fore)],
+                                  w.f.rot[bi(upper)].conjugate() * (target.pos_m - elbow));
+    }
+    settle_hinge(m, w, fore, angle);
+    settle_ball(m, w, hand, target.rot);
+    if (!sol.reached) out.flags |= kIkHandUnreachable;
+  }
+
+  // 5. Legs.
+  if (!st.started) st.pelvis_velocity = Vec3::Zero();
+  if (st.started && dt > 0.0) {
+    const double alpha = dt / (o.velocity_time_constant_s + dt);
+    st.pelvis_velocity += alpha * ((pelvis_now - st.last_pelvis) / dt - st.pelvis_velocity);
+  }
+  st.last_pelvis = pelvis_now;
+  const double pelvis_yaw = yaw_of(w.f.rot[0] * Vec3::UnitX(), yaw);
+  if (!st.started) detail::plant_feet(m, st, pelvis_now, pelvis_yaw);
+  std::array<Vec3, 2> hip{};
+  for (std::size_t s = 0; s < 2; ++s) hip[s] = w.f.pos[0] + w.f.rot[0] * m.offset[bi(kThigh[s])];
+  std::array<detail::FootTarget, 2> steps{};
+  std::array<bool, 2> tracked{};
+  for (std::size_t s = 0; s < 2; ++s) {
+    tracked[s] = m.calibration.offset[index(kFootTracker[s])].valid && st.track[index(kFootTracker[s])].target.valid;
+  }
+  if (detail::advance_feet(m, st, pelvis_now, pelvis_yaw, dt, tracked, steps)) ++st.stats.steps;
+  for (std::size_t s = 0; s < 2; ++s) {
+    const Bone thigh = kThigh[s];
+    const Bone shank = static_cast<Bone>(bi(thigh) + 1);
+    const Bone foot = static_cast<Bone>(bi(thigh) + 2);
+    const Bone toes = static_cast<Bone>(bi(thigh) + 3);
+    if (st.foot[s].phase >= 0.0) out.flags |= kIkStepping;
+    TrackerPose target{steps[s].ankle, yaw_quat(steps[s].yaw_rad), true};
+    IkState::Track& ft = st.track[index(kFootTracker[s])];
+    if (m.calibration.offset[index(kFootTracker[s])].valid && ft.seen) {
+      target = detail::effective_pose(target, dt, o, ft, out.use[index(kFootTracker[s])]);
+      if (ft.target.valid) {
+        // The procedural foot follows the tracked one, ready to take over.
+        st.foot[s].planted = target.pos_m;
+        st.foot[s].yaw_rad = yaw_of(target.rot * Vec3::UnitX(), st.foot[s].yaw_rad);
+        st.foot[s].phase = -1.0;
+      }
+    }
+    const Vec3 foot_fwd = horizontal(target.rot * Vec3::UnitX());
+    Vec3 pole = foot_fwd.norm() > 1e-6 ? Vec3(foot_fwd.normalized()) : Vec3(body_yaw * Vec3::UnitX());
+    IkState::Track& kt = st.track[index(kKnee[s])];
+    if (m.calibration.offset[index(kKnee[s])].valid && kt.seen) {
+      const TrackerPose k = detail::effective_pose(TrackerPose{hip[s] + pole, Quat::Identity(), true}, dt, o, kt,
+                                                   out.use[index(kKnee[s])]);
+      pole = k.pos_m - hip[s];
+    }
+    detail::TwoBoneLimb limb{m.rest_dir[bi(thigh)], m.rest_dir[bi(shank)], m.hinge_axis[bi(shank)], m.thigh_m[s],
+                             m.shank_m[s]};
+    const detail::TwoBoneSolution sol =
+        detail::solve_two_bone(limb, hip[s], target.pos_m, pole, body_yaw * Vec3::UnitX());
+    double angle = sol.hinge_rad;
+    if (settle_ball(m, w, thigh, sol.upper)) {
+      const Vec3 knee = hip[s] + w.f.rot[bi(thigh)] * m.offset[bi(shank)];
+      angle = detail::angle_about(m.hinge_axis[bi(shank)], m.rest_dir[bi(shank)],
+                                  w.f.rot[bi(thigh)].conjugate() * (target.pos_m - knee));
+    }
+    settle_hinge(m, w, shank, angle);
+    settle_ball(m, w, foot, target.rot);
+    settle_hinge(m, w, toes, 0.0);
+    if (!sol.reached) out.flags |= kIkFootUnreachable;
+  }
+  st.started = true;
+
+  // 6. The configuration, and what it reaches.
+  w.f.pos[0] = pelvis_now;
+  detail::place_bones(m.offset, pelvis_now, w.f);
+  out.joint_pos = w.f.pos;
+  out.head_error_m = (w.f.pos[bi(Bone::Head)] - head.pos_m).norm();
+  for (std::size_t s = 0; s < 2; ++s) {
+    out.hand_error_m[s] = (w.f.pos[bi(kUpperArm[s]) + 2] - st.track[index(kHand[s])].shown.pos_m).norm();
+    out.foot_error_m[s] = (w.f.pos[bi(kThigh[s]) + 2] - steps[s].ankle).norm();
+    if (m.calibration.offset[index(kFootTracker[s])].valid && st.track[index(kFootTracker[s])].seen) {
+      out.foot_error_m[s] = (w.f.pos[bi(kThigh[s]) + 2] - st.track[index(kFootTracker[s])].shown.pos_m).norm();
+    }
+  }
+  if (!m.calibration.offset[index(Tracker::left_hand)].valid) out.hand_error_m[0] = 0.0;
+  if (!m.calibration.offset[index(Tracker::right_hand)].valid) out.hand_error_m[1] = 0.0;
+  // A limb whose joint ranges kept it off its target is unreachable too; so
+  // is a head the clamped spine missed.
+  if (out.head_error_m > kReachedTolerance_m) out.flags |= kIkHeadMissed;
+  for (std::size_t s = 0; s < 2; ++s) {
+    if (out.hand_error_m[s] > kReachedTolerance_m) out.flags |= kIkHandUnreachable;
+    if (out.foot_error_m[s] > kReachedTolerance_m) out.flags |= kIkFootUnreachable;
+  }
+  out.joints_clamped = w.clamped;
+  if (w.clamped > 0) {
+    out.flags |= kIkJointClamped;
+    ++st.stats.clamped_frames;
+  }
+  if (out.flags & kIkImplausible) ++st.stats.implausible_frames;
+  for (std::size_t t = 0; t < kTrackerCount; ++t) {
+    if (out.use[t] == TrackerUse::held) out.flags |= kIkTrackerHeld;
+    if (out.use[t] == TrackerUse::easing || (out.use[t] == TrackerUse::neutral && st.track[t].seen)) {
+      out.flags |= kIkTrackerEased;
+    }
+  }
+
+  const auto put_quat = [&](int adr, const Quat& q) {
+    auto at = [&](int k) -> double& { return out.qpos[static_cast<std::size_t>(adr + k)]; };
+    Quat u = q.normalized();
+    const double dot = st.last_qpos[static_cast<std::size_t>(adr)] * u.w() +
+                       st.last_qpos[static_cast<std::size_t>(adr + 1)] * u.x() +
+                       st.last_qpos[static_cast<std::size_t>(adr + 2)] * u.y() +
+                       st.last_qpos[static_cast<std::size_t>(adr + 3)] * u.z();
+    if (dot < 0.0) u.coeffs() = -u.coeffs();
+    at(0) = u.w();
+    at(1) = u.x();
+    at(2) = u.y();
+    at(3) = u.z();
+  };
+  out.qpos[0] = pelvis_now.x();
+  out.qpos[1] = pelvis_now.y();
+  out.qpos[2] = pelvis_now.z();
+  put_quat(3, w.f.rot[0]);
+  for (std::size_t i = 1; i < sim::kBoneCount; ++i) {
+    const int adr = m.qpos_adr[i];
+    if (m.joint[i] == sim::JointType::hinge) {
+      out.qpos[static_cast<std::size_t>(adr)] = w.angle[i];
+    } else {
+      put_quat(adr, w.local[i]);
+    }
+  }
+  bool finite = true;
+  for (int i = 0; i < m.nq; ++i) finite = finite && std::isfinite(out.qpos[static_cast<std::size_t>(i)]);
+  if (!finite) {
+    // Never hand on a NaN: keep the last configuration.
+    out.qpos = st.last_qpos;
+    out.flags |= kIkTrackerInvalid;
+  }
+  st.last_qpos = out.qpos;
+}
+
+}  // namespace tonus::reference

@@ -1,0 +1,58 @@
+#include "two_bone.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "rotations.hpp"
+
+namespace tonus::reference::detail {
+namespace {
+
+// The part of v across the unit direction d, made unit; false when too short.
+bool across(const sim::Vec3& v, const sim::Vec3& d, sim::Vec3& out) {
+  const sim::Vec3 p = v - v.dot(d) * d;
+  const double n = p.norm();
+  if (n < 1e-6) return false;
+  out = p / n;
+  return true;
+}
+
+}  // namespace
+
+TwoBoneSolution solve_two_bone(const TwoBoneLimb& limb, const sim::Vec3& root, const sim::Vec3& target,
+                               const sim::Vec3& pole, const sim::Vec3& fallback_pole) {
+  TwoBoneSolution s;
+  const double a = limb.upper_m, b = limb.lower_m;
+  sim::Vec3 d = target - root;
+  double dist = d.norm();
+  sim::Vec3 dir;
+  if (dist < 1e-9) {
+    dir = fallback_pole.norm() > 1e-9 ? sim::Vec3(-fallback_pole.normalized()) : sim::Vec3(-sim::Vec3::UnitZ());
+  } else {
+    dir = d / dist;
+  }
+  const double shortest = std::abs(a - b) + 1e-9, longest = a + b;
+  if (dist > longest) s.reached = false;
+  if (dist < shortest) s.reached = false;
+  dist = std::clamp(dist, shortest, longest);
+
+  sim::Vec3 p;
+  if (!across(pole, dir, p) && !across(fallback_pole, dir, p)) {
+    sim::Vec3 any = std::abs(dir.x()) < 0.9 ? sim::Vec3::UnitX() : sim::Vec3::UnitY();
+    across(any, dir, p);
+  }
+  const double cos_a = std::clamp((a * a + dist * dist - b * b) / (2.0 * a * dist), -1.0, 1.0);
+  const double sin_a = std::sqrt(std::max(0.0, 1.0 - cos_a * cos_a));
+  const sim::Vec3 middle = root + a * (cos_a * dir + sin_a * p);
+  const sim::Vec3 end = root + dist * dir;
+  const sim::Vec3 u = (middle - root) / a;
+  const sim::Vec3 f = (end - middle) / b;
+  const sim::Vec3 n = p.cross(dir);  // the hinge axis in the world for a positive bend
+  if (!frame_match(limb.upper_dir, limb.hinge, u, n, s.upper)) {
+    s.upper = sim::Quat::FromTwoVectors(limb.upper_dir, u);
+  }
+  s.hinge_rad = angle_about(limb.hinge, limb.lower_dir, s.upper.conjugate() * f);
+  return s;
+}
+
+}  // namespace tonus::reference::detail

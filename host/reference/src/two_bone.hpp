@@ -1,0 +1,31 @@
+// Two-bone limbs (upper arm + forearm, thigh + shank) solved in closed form:
+// the law of cosines for the middle joint's angle, a pole direction for the
+// plane the limb bends in.
+#pragma once
+
+#include "tonus/sim/math.hpp"
+
+namespace tonus::reference::detail {
+
+struct TwoBoneLimb {
+  sim::Vec3 upper_dir;  // the upper bone's rest direction to the middle joint (its frame, unit)
+  sim::Vec3 lower_dir;  // the lower bone's rest direction to the end joint (its frame, unit)
+  sim::Vec3 hinge;      // the middle joint's axis (upper bone's frame, unit), positive angle = flexion
+  double upper_m = 0.0;
+  double lower_m = 0.0;
+};
+
+struct TwoBoneSolution {
+  sim::Quat upper = sim::Quat::Identity();  // the upper bone's world rotation
+  double hinge_rad = 0.0;                   // the middle joint's angle
+  bool reached = true;                      // false: the target was out of reach (the limb points at it)
+};
+
+// Puts the end joint on `target` from the upper joint at `root`. The middle
+// joint goes toward `pole` (the part of it across the root-target line);
+// `fallback_pole` when that part vanishes. The positive hinge angle must bend
+// the limb toward the side the pole names as the middle joint's.
+TwoBoneSolution solve_two_bone(const TwoBoneLimb& limb, const sim::Vec3& root, const sim::Vec3& target,
+                               const sim::Vec3& pole, const sim::Vec3& fallback_pole);
+
+}  // namespace tonus::reference::detail
