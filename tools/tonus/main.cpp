@@ -4,6 +4,7 @@
 #include <exception>
 
 #include "experiment_command.hpp"
+#include "ik_command.hpp"
 #include "physics_demo.hpp"
 #include "protocol_demo.hpp"
 #include "zmp_command.hpp"
@@ -90,7 +91,21 @@ int run(int argc, char** argv) {
       ->check(CLI::Range(0.1, 600.0));
   experiment_cmd->add_flag("-q,--quiet", experiment.quiet, "No report on stdout");
 
+  tonus::tools::IkCommandOptions ik;
+  CLI::App* ik_cmd = app.add_subcommand(
+      "ik",
+      "Solve a real clip's full body from the trackers a performer would wear (3: head, hands; 6: + waist, "
+      "feet) and compare with the clip");
+  ik_cmd->add_option("clip", ik.clip, "Input BVH file")->required();
+  ik_cmd->add_option("--trackers", ik.trackers, "3 or 6")->check(CLI::IsMember({3, 6}));
+  ik_cmd->add_option("--json", ik.json, "Write the JSON report here");
+  ik_cmd->add_option("--svg", ik.svg, "Write the plot here");
+  ik_cmd->add_option("--mapping", ik.mapping, "Joint-name mapping file: lines 'HumanBodyBone = JointName'");
+  ik_cmd->add_option("--seconds", ik.seconds, "At most this much of the clip")->check(CLI::Range(0.1, 3600.0));
+  ik_cmd->add_flag("-q,--quiet", ik.quiet, "No report on stdout");
+
   CLI11_PARSE(app, argc, argv);
+  if (ik_cmd->parsed()) return tonus::tools::run_ik_command(ik);
   if (experiment_cmd->parsed()) return tonus::tools::run_experiment(experiment);
   if (zmp_cmd->parsed()) return tonus::tools::run_zmp_command(zmp);
   if (demo_cmd->parsed()) return tonus::tools::run_protocol_demo(demo);

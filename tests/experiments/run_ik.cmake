@@ -1,0 +1,18 @@
+# Runs `tonus ik CLIP --trackers N --json OUT`, then checks OUT with check_ik.py;
+# with EXPECT_FAIL, checks instead that the tool refuses CLIP with a message.
+execute_process(COMMAND ${TONUS} ik ${CLIP} --trackers ${N} --json ${OUT} -q RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(EXPECT_FAIL)
+  if(rc EQUAL 0 OR NOT err MATCHES "cannot map the skeleton")
+    message(FATAL_ERROR "tonus ik accepted an unmappable clip (exit ${rc}): ${err}")
+  endif()
+  message("refused as it should: ${err}")
+  return()
+endif()
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "tonus ik exited with ${rc}: ${err}")
+endif()
+execute_process(COMMAND python3 ${CHECK} ${OUT} ${N} RESULT_VARIABLE rc2 OUTPUT_VARIABLE out ERROR_VARIABLE err2)
+message("${out}${err2}")
+if(NOT rc2 EQUAL 0)
+  message(FATAL_ERROR "the tonus ik report does not hold what it should")
+endif()

@@ -1,0 +1,52 @@
+// The tracker IK on real walks (tools/tonus/experiments/ik_eval.hpp): the
+// issue's goals, the trackers synthesized from sim's kinematics of the clip
+// retargeted onto a humanoid, the solution judged by sim's kinematics too.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+
+#include "experiments/ik_eval.hpp"
+
+namespace tonus::experiments {
+namespace {
+
+std::vector<std::string> walks() {
+  std::vector<std::string> clips{std::string(TONUS_SOURCE_DIR) + "/tests/data/cmu_02_walk.bvh"};
+  const std::string bandai = std::string(TONUS_SHARED_DATA_DIR) + "/bvh/dataset-1_walk_normal_001.bvh";
+  if (std::filesystem::exists(bandai)) clips.push_back(bandai);
+  return clips;
+}
+
+TEST_CASE("tonus ik: walks from 3 and 6 trackers meet the goals") {
+  for (const std::string& clip : walks()) {
+    for (const int trackers : {3, 6}) {
+      CAPTURE(clip);
+      CAPTURE(trackers);
+      IkEvalOptions opt;
+      opt.clip = clip;
+      opt.trackers = trackers;
+      const IkEvalResult r = run_ik_eval(opt);
+      REQUIRE_MESSAGE(r.error.empty(), r.error);
+      REQUIRE(r.runs.size() == 3);
+      const IkRun& clean = r.runs[0];
+      MESSAGE(clip << " " << trackers << " trackers: MPJPE " << clean.mpjpe_cm << " cm (upper " << clean.mpjpe_upper_cm
+                   << ", lower " << clean.mpjpe_lower_cm << "), wrists within 1 mm " << clean.hand_within_1mm_share
+                   << ", jitter x" << clean.jitter_ratio << "; noise " << r.runs[1].mpjpe_cm << " cm, dropouts "
+                   << r.runs[2].mpjpe_cm << " cm");
+      // The calibration recovers the clip's stature from its T-pose.
+      CHECK(r.calibrated_height_m == doctest::Approx(r.truth_height_m).epsilon(0.01));
+      // 3 points: half of Final IK's 18.1 cm; 6 points: 3 cm.
+      CHECK(clean.mpjpe_cm <= (trackers == 3 ? 9.0 : 3.0));
+      // The head is always placed (3 points) or reached within 1.5 mm (6: the spine's ranges).
+      CHECK(clean.head_error_max_mm <= (trackers == 3 ? 1e-3 : 1.5));
+      CHECK(clean.hand_within_1mm_share >= 0.8);
+      CHECK(clean.hand_error_max_reached_mm <= 1.0);
+      // Noise and dropouts cost something, and nothing breaks.
+      CHECK(r.runs[1].mpjpe_cm < clean.mpjpe_cm + 2.0);
+      CHECK(r.runs[2].mpjpe_cm < 3.0 * clean.mpjpe_cm + 10.0);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace tonus::experiments
