@@ -34,6 +34,7 @@ constexpr int kSpineIterations = 24;
 constexpr int kClavicleBisections = 40;
 constexpr int kTwistCorrections = 3;
 constexpr double kReachedTolerance_m = 1e-3;
+constexpr double kPelvisKneeWeight = 0.5;
 constexpr double kTwistMargin_rad = 0.05;
 
 double yaw_of(const Vec3& forward, double fallback) {
@@ -412,8 +413,13 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
         st.foot[s].phase = -1.0;
       }
     }
-    const Vec3 foot_fwd = horizontal(target.rot * Vec3::UnitX());
-    Vec3 pole = foot_fwd.norm() > 1e-6 ? Vec3(foot_fwd.normalized()) : Vec3(body_yaw * Vec3::UnitX());
+    // Knee: toward the foot's facing (its forward, or its up when the toes
+    // point down, so a pointed foot does not flip the knee back), with some of
+    // the pelvis's.
+    const Vec3 foot_fwd = horizontal(target.rot * Vec3::UnitX()) + horizontal(target.rot * Vec3::UnitZ());
+    const Vec3 pelvis_fwd = horizontal(w.f.rot[0] * Vec3::UnitX());
+    Vec3 pole = (foot_fwd.norm() > 1e-6 ? Vec3(foot_fwd.normalized()) : Vec3::Zero()) +
+                kPelvisKneeWeight * (pelvis_fwd.norm() > 1e-6 ? Vec3(pelvis_fwd.normalized()) : Vec3::Zero());
     IkState::Track& kt = st.track[index(kKnee[s])];
     if (m.calibration.offset[index(kKnee[s])].valid && kt.seen) {
       const TrackerPose k = detail::effective_pose(TrackerPose{hip[s] + pole, Quat::Identity(), true}, dt, o, kt,

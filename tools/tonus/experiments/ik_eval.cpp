@@ -73,13 +73,6 @@ TrackerFrame trackers_of(const sim::Data& data, const std::array<TrackerPose, re
   return f;
 }
 
-struct Truth {
-  std::unique_ptr<sim::Model> model;
-  std::vector<std::array<Vec3, sim::kBoneCount>> joints;
-  std::vector<TrackerFrame> trackers;
-  double dt_s = 0.0;
-};
-
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0.0;
   const auto k = static_cast<std::size_t>(std::clamp(p, 0.0, 1.0) * static_cast<double>(v.size() - 1));
@@ -101,7 +94,7 @@ double jitter(const std::vector<std::array<Vec3, sim::kBoneCount>>& j, double dt
   return sum / static_cast<double>(n) / (dt * dt * dt);
 }
 
-IkRun run_condition(const std::string& condition, const Truth& truth, const reference::IkModel& ik,
+IkRun run_condition(const std::string& condition, const IkSetup& truth, const reference::IkModel& ik,
                     const sim::Model& solved_model, const IkEvalOptions& opt) {
   IkRun run;
   run.condition = condition;
@@ -243,25 +236,25 @@ IkRun run_condition(const std::string& condition, const Truth& truth, const refe
 
 }  // namespace
 
-IkEvalResult run_ik_eval(const IkEvalOptions& opt) {
-  IkEvalResult r;
+IkSetup prepare_ik_eval(const IkEvalOptions& opt, IkEvalResult& r) {
+  IkSetup truth;
   r.clip = opt.clip;
   r.trackers = opt.trackers;
   if (opt.trackers != 3 && opt.trackers != 6) {
     r.error = "--trackers must be 3 (head, hands) or 6 (+ waist, feet)";
-    return r;
+    return truth;
   }
   try {
     const motion::ReadResult read = motion::read_bvh_file(opt.clip);
     if (!read.ok()) {
       r.error = opt.clip + (read.error->line > 0 ? ":" + std::to_string(read.error->line) : std::string()) + ": " +
                 read.error->message;
-      return r;
+      return truth;
     }
     const balance::MapResult mapping = balance::map_skeleton(read.clip, opt.mapping_text);
     if (!mapping.ok()) {
       r.error = opt.clip + ": cannot map the skeleton onto the humanoid: " + mapping.error;
-      return r;
+      return truth;
     }
     r.convention = mapping.map.convention;
     for (std::size_t b = 0; b < sim::kBoneCount; ++b) {
@@ -272,18 +265,18 @@ IkEvalResult run_ik_eval(const IkEvalOptions& opt) {
     const balance::Conversion conv = balance::convert_motion(read.clip, mapping, balance::ConvertOptions{});
     if (!conv.ok()) {
       r.error = opt.clip + ": " + conv.error;
-      return r;
+      return truth;
     }
     // The clip's stature: its legs against a reference humanoid's.
     sim::BuildResult ref_model = sim::build_humanoid(sim::HumanoidSpec{});
     if (!ref_model) {
       r.error = ref_model.error;
-      return r;
+      return truth;
     }
     const reference::ClipReference scaled = reference::clip_to_reference(*ref_model.model, conv.motion);
     if (!scaled.ok()) {
       r.error = opt.clip + ": " + scaled.error;
-      return r;
+      return truth;
     }
     r.truth_height_m = std::clamp(kReferenceHeight_m / scaled.scale, 1.2, 2.2);
     sim::HumanoidSpec truth_spec;
@@ -292,18 +285,17 @@ IkEvalResult run_ik_eval(const IkEvalOptions& opt) {
     sim::BuildResult truth_model = sim::build_humanoid(truth_spec);
     if (!truth_model) {
       r.error = truth_model.error;
-      return r;
+      return truth;
     }
     const reference::ClipReference clip = reference::clip_to_reference(*truth_model.model, conv.motion);
     if (!clip.ok()) {
       r.error = opt.clip + ": " + clip.error;
-      return r;
+      return truth;
     }
     r.messages = clip.messages;
     r.frame_time_s = clip.dt_s;
 
     // The ground truth: joints and trackers from sim's kinematics.
-    Truth truth;
     truth.model = std::move(truth_model.model);
     truth.dt_s = clip.dt_s;
     const auto offsets = worn_offsets(r.truth_height_m);
@@ -323,7 +315,7 @@ IkEvalResult run_ik_eval(const IkEvalOptions& opt) {
     }
     if (truth.joints.size() < 4) {
       r.error = opt.clip + ": too few frames to evaluate";
-      return r;
+      return truth;
     }
     // Calibration: the performer stands in a T-pose first.
     data->qpos = truth.model->qpos0;
@@ -331,26 +323,35 @@ IkEvalResult run_ik_eval(const IkEvalOptions& opt) {
     const reference::CalibrationResult cal = reference::calibrate(trackers_of(*data, offsets, worn));
     if (!cal.ok()) {
       r.error = cal.error;
-      return r;
+      return truth;
     }
     r.calibrated_height_m = cal.body.height_m;
     r.arm_scale = cal.body.arm_scale;
     sim::BuildResult solved_model = sim::build_humanoid(reference::calibrated_spec(cal.body, kMassKg));
     if (!solved_model) {
       r.error = solved_model.error;
-      return r;
+      return truth;
     }
-    const reference::IkCreated ik = reference::make_ik_model(*solved_model.model, cal.body);
+    reference::IkCreated ik = reference::make_ik_model(*solved_model.model, cal.body);
     if (!ik.model) {
       r.error = ik.error;
-      return r;
+      return truth;
     }
+    truth.solved = std::move(solved_model.model);
+    truth.ik = std::move(ik.model);
     r.source_jitter_mps3 = jitter(truth.joints, truth.dt_s);
-    for (const char* c : {"clean", "noise", "dropouts"}) {
-      r.runs.push_back(run_condition(c, truth, *ik.model, *solved_model.model, opt));
-    }
   } catch (const std::exception& e) {
     r.error = opt.clip + ": " + e.what();
+  }
+  return truth;
+}
+
+IkEvalResult run_ik_eval(const IkEvalOptions& opt) {
+  IkEvalResult r;
+  const IkSetup setup = prepare_ik_eval(opt, r);
+  if (!r.error.empty()) return r;
+  for (const char* c : {"clean", "noise", "dropouts"}) {
+    r.runs.push_back(run_condition(c, setup, *setup.ik, *setup.solved, opt));
   }
   return r;
 }

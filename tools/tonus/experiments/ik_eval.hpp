@@ -9,8 +9,13 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "tonus/host/reference/tracker_ik.hpp"
+#include "tonus/sim/model.hpp"
 
 namespace tonus::experiments {
 
@@ -61,6 +66,21 @@ struct IkEvalResult {
   std::vector<std::string> messages;
   std::string error;
 };
+
+// What a run needs, made once: the ground truth (its humanoid, its joints
+// and the trackers per frame), and the calibrated humanoid and solver.
+struct IkSetup {
+  std::unique_ptr<sim::Model> model;  // the truth's humanoid
+  std::vector<std::array<sim::Vec3, sim::kBoneCount>> joints;
+  std::vector<reference::TrackerFrame> trackers;
+  double dt_s = 0.0;
+  std::unique_ptr<sim::Model> solved;  // the humanoid the calibration builds
+  std::optional<reference::IkModel> ik;
+};
+
+// Reads, maps, retargets, synthesizes the trackers and calibrates; fills the
+// result's description (or its error).
+IkSetup prepare_ik_eval(const IkEvalOptions& options, IkEvalResult& result);
 
 IkEvalResult run_ik_eval(const IkEvalOptions& options);
 

@@ -1,0 +1,61 @@
+// One tracker IK solve (host/reference/tracker_ik.hpp), 3 and 6 points, on
+// real walks: the bundled CMU walk (120 Hz) and, when ../shared/data is
+// there, the Bandai Namco walk and the CMU jumps (the lively case). The
+// tracker streams are the `tonus ik` evaluation's (tools/tonus/experiments);
+// each iteration solves the next frame of the loop, so steps, clamps and the
+// spine's reach are all in the figure. Goal: at most 20 us per solve.
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <string>
+
+#include "experiments/ik_eval.hpp"
+
+namespace {
+
+using namespace tonus;
+
+void solve(benchmark::State& state, const std::string& clip, int trackers) {
+  if (!std::filesystem::exists(clip)) {
+    state.SkipWithError("clip not found");
+    return;
+  }
+  experiments::IkEvalOptions opt;
+  opt.clip = clip;
+  opt.trackers = trackers;
+  experiments::IkEvalResult r;
+  const experiments::IkSetup setup = experiments::prepare_ik_eval(opt, r);
+  if (!r.error.empty() || !setup.ik) {
+    state.SkipWithError(r.error.c_str());
+    return;
+  }
+  reference::IkState ik_state;
+  reference::IkOutput out;
+  std::size_t f = 0;
+  double t = 0.0;
+  for (auto _ : state) {
+    reference::TrackerFrame frame = setup.trackers[f];
+    frame.time_s = t;
+    reference::solve_ik(*setup.ik, ik_state, frame, out);
+    benchmark::DoNotOptimize(out.qpos.data());
+    benchmark::ClobberMemory();
+    f = (f + 1) % setup.trackers.size();
+    t += setup.dt_s;
+  }
+  state.counters["frames"] = static_cast<double>(setup.trackers.size());
+}
+
+const std::string kCmuWalk = std::string(TONUS_SOURCE_DIR) + "/tests/data/cmu_02_walk.bvh";
+const std::string kBandaiWalk = std::string(TONUS_SHARED_DATA_DIR) + "/bvh/dataset-1_walk_normal_001.bvh";
+const std::string kJumps = std::string(TONUS_SHARED_DATA_DIR) + "/bvh/cmu_01_01_jumps.bvh";
+
+BENCHMARK_CAPTURE(solve, cmu_walk_3, kCmuWalk, 3)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(solve, cmu_walk_6, kCmuWalk, 6)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(solve, bandai_walk_3, kBandaiWalk, 3)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(solve, bandai_walk_6, kBandaiWalk, 6)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(solve, cmu_jumps_3, kJumps, 3)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(solve, cmu_jumps_6, kJumps, 6)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
