@@ -146,8 +146,12 @@ TEST_CASE("tracker IK: the calibration pose solves back to itself") {
       const auto truth = truth_joints(rig);
       solve_ik(*rig.ik, state, frame, out);
       const auto j = solved_joints(rig, out.qpos);
-      // Exact offsets: the pose itself. Calibrated: within what the calibration assumes (1-2 cm).
-      CHECK(mean_joint_error(j, truth) < (exact ? 1e-6 : 0.02));
+      // Exact offsets: the pose itself, but for the straight arms' soft reach (elbows bent by a few degrees);
+      // calibrated: within what the calibration assumes (1-2 cm).
+      CHECK(mean_joint_error(j, truth) < (exact ? 0.003 : 0.02));
+      for (const Bone b : {Bone::Hips, Bone::Head, Bone::LeftFoot, Bone::RightFoot}) {
+        CHECK((j[sim::index(b)] - truth[sim::index(b)]).norm() < (exact ? 1e-6 : 0.02));
+      }
       CHECK((j[sim::index(Bone::Head)] - bone_target(rig, frame, Tracker::head)).norm() < kMm);
       CHECK((j[sim::index(Bone::LeftHand)] - bone_target(rig, frame, Tracker::left_hand)).norm() < kMm);
       CHECK((j[sim::index(Bone::RightHand)] - bone_target(rig, frame, Tracker::right_hand)).norm() < kMm);

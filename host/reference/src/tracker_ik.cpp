@@ -30,12 +30,20 @@ constexpr std::array<Tracker, 2> kHand{Tracker::left_hand, Tracker::right_hand};
 constexpr std::array<Tracker, 2> kFootTracker{Tracker::left_foot, Tracker::right_foot};
 constexpr std::array<Tracker, 2> kElbow{Tracker::left_elbow, Tracker::right_elbow};
 constexpr std::array<Tracker, 2> kKnee{Tracker::left_knee, Tracker::right_knee};
-constexpr int kSpineIterations = 24;
-constexpr int kClavicleBisections = 40;
+constexpr int kClavicleBisections = 24;
+constexpr double kSoftness = 0.05;  // of the smooth maxima (shares, sines)
 constexpr int kTwistCorrections = 3;
 constexpr double kReachedTolerance_m = 1e-3;
 constexpr double kPelvisKneeWeight = 0.5;
 constexpr double kTwistMargin_rad = 0.05;
+
+// max(a, b) with the corner rounded over `soft`: never below either.
+double smooth_max(double a, double b, double soft) {
+  return 0.5 * (a + b + std::sqrt((a - b) * (a - b) + soft * soft));
+}
+
+// The share of the way a first-order filter of time constant tau moves in dt.
+double smoothing(double dt, double tau) { return tau > 0.0 ? dt / (tau + dt) : 1.0; }
 
 double yaw_of(const Vec3& forward, double fallback) {
   const Vec3 f = horizontal(forward);
@@ -79,24 +87,30 @@ Vec3 joint_of(const Work& w, const IkModel& m, Bone b) {
   return w.f.pos[p] + w.f.rot[p] * m.offset[i];
 }
 
-// FABRIK on the spine's three links (spine, chest, neck) from the fixed
-// spine joint to the head joint. `pts` starts as the current chain.
-bool reach_head(std::array<Vec3, 4>& pts, const std::array<double, 3>& len, const Vec3& target) {
-  const Vec3 base = pts[0];
-  if ((target - base).norm() >= len[0] + len[1] + len[2]) {
-    const Vec3 d = (target - base).normalized();
-    for (std::size_t k = 1; k < 4; ++k) pts[k] = pts[k - 1] + len[k - 1] * d;
+// Where the neck joint goes so the neck reaches the head joint, the spine
+// and chest turned as one piece about the spine joint `base`: on the circle
+// where the sphere the lower trunk's end can reach (about the base) meets the
+// sphere of the neck's length (about the head), the point nearest the guess.
+// Closed form, so a smooth function of its inputs, and the neck takes the
+// head's quick moves as a real neck does. False (the trunk pointed straight
+// at the head) when no such point exists.
+bool reach_head(const Vec3& base, const Vec3& neck_guess, double neck_m, const Vec3& head, Vec3& neck_joint) {
+  const Vec3 to_head = head - base;
+  const double dist = to_head.norm();
+  const double trunk_m = (neck_guess - base).norm();
+  if (dist < 1e-9 || trunk_m < 1e-9) {
+    neck_joint = neck_guess;
     return false;
   }
-  // A fixed number of sweeps, no early exit: the result is then a smooth
-  // function of the targets (a tolerance test would make it jump).
-  for (int it = 0; it < kSpineIterations; ++it) {
-    pts[3] = target;
-    for (std::size_t k = 3; k-- > 0;) pts[k] = pts[k + 1] + len[k] * (pts[k] - pts[k + 1]).normalized();
-    pts[0] = base;
-    for (std::size_t k = 1; k < 4; ++k) pts[k] = pts[k - 1] + len[k - 1] * (pts[k] - pts[k - 1]).normalized();
-  }
-  return true;
+  const Vec3 u = to_head / dist;
+  const bool reachable = dist <= trunk_m + neck_m && dist >= std::abs(trunk_m - neck_m);
+  const double along =
+      std::clamp((trunk_m * trunk_m - neck_m * neck_m + dist * dist) / (2.0 * dist), -trunk_m, trunk_m);
+  const double across = std::sqrt(std::max(0.0, trunk_m * trunk_m - along * along));
+  Vec3 side = (neck_guess - base) - (neck_guess - base).dot(u) * u;
+  side = side.norm() > 1e-9 ? Vec3(side.normalized()) : Vec3(u.unitOrthogonal());
+  neck_joint = base + along * u + across * side;
+  return reachable;
 }
 
 }  // namespace
@@ -118,7 +132,7 @@ IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calib
   const IkOptions& o = options;
   const bool times_ok = o.step_time_s > 0.0 && o.step_time_min_s > 0.0 && o.step_time_min_s <= o.step_time_s &&
                         o.hold_s >= 0.0 && o.ease_s >= 0.0 && o.recover_s >= 0.0 && o.step_lead_s >= 0.0 &&
-                        o.velocity_time_constant_s >= 0.0;
+                        o.velocity_time_constant_s >= 0.0 && o.trunk_smoothing_s >= 0.0 && o.elbow_smoothing_s >= 0.0;
   const bool sizes_ok =
       o.step_threshold_m > 0.0 && o.step_turn_rad > 0.0 && o.step_lift_m >= 0.0 && o.implausible_reach_factor > 1.0;
   const bool shares_ok = o.pelvis_share >= 0.0 && o.spine_share >= 0.0 && o.chest_share >= 0.0 && o.neck_share >= 0.0 &&
@@ -234,12 +248,18 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
   const Quat heading = yaw_quat(yaw);
 
   // 3. Trunk: each bone takes its share of the head's turn from the heading.
+  // The trunk follows the head's turn smoothed (a head's quick nods and
+  // shakes are the neck's); the neck and head follow it as it is.
   const Quat head_rel = (heading.conjugate() * head.rot).normalized();
-  const auto share = [&](double s) { return (heading * Quat::Identity().slerp(s, head_rel)).normalized(); };
+  if (!st.started) st.trunk_turn = head_rel;
+  if (st.trunk_turn.dot(head_rel) < 0.0) st.trunk_turn.coeffs() = -st.trunk_turn.coeffs();
+  st.trunk_turn = st.trunk_turn.slerp(smoothing(dt, o.trunk_smoothing_s), head_rel).normalized();
+  const auto share = [&](double s) { return (heading * Quat::Identity().slerp(s, st.trunk_turn)).normalized(); };
+  const auto head_share = [&](double s) { return (heading * Quat::Identity().slerp(s, head_rel)).normalized(); };
   w.f.rot[bi(Bone::Hips)] = share(o.pelvis_share);
   settle_ball(m, w, Bone::Spine, share(o.spine_share));
   settle_ball(m, w, Bone::Chest, share(o.chest_share));
-  settle_ball(m, w, Bone::Neck, share(o.neck_share));
+  settle_ball(m, w, Bone::Neck, head_share(o.neck_share));
   settle_ball(m, w, Bone::Head, head.rot);
   // The pelvis that puts the head joint exactly on its target.
   Vec3 pelvis = head.pos_m;
@@ -256,24 +276,19 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     const TrackerPose hips = detail::effective_pose(estimate, dt, o, waist, out.use[index(Tracker::waist)]);
     w.f.pos[0] = hips.pos_m;
     w.f.rot[0] = hips.rot;
-    std::array<Vec3, 4> pts{};
-    pts[0] = hips.pos_m + hips.rot * m.offset[bi(Bone::Spine)];
-    // Start from the 3-point chain's shape, carried to the new pelvis.
+    // Start from the 3-point trunk's shape, carried to the new pelvis.
     const Quat carry = (hips.rot * share(o.pelvis_share).conjugate()).normalized();
-    const std::array<Bone, 3> links{Bone::Spine, Bone::Chest, Bone::Neck};
-    std::array<double, 3> len{};
-    for (std::size_t k = 0; k < 3; ++k) {
-      const Vec3 seg = m.offset[bi(links[k]) + 1];
-      len[k] = seg.norm();
-      pts[k + 1] = pts[k] + carry * (w.f.rot[bi(links[k])] * seg);
-    }
-    const bool reachable = reach_head(pts, len, head.pos_m);
-    std::array<Quat, 3> aimed{};
-    for (std::size_t k = 0; k < 3; ++k) {
-      const Quat start = (carry * w.f.rot[bi(links[k])]).normalized();
-      aimed[k] = detail::aim(start, m.rest_dir[bi(links[k])], pts[k + 1] - pts[k]);
-    }
-    for (std::size_t k = 0; k < 3; ++k) settle_ball(m, w, links[k], aimed[k]);
+    const Quat spine = (carry * w.f.rot[bi(Bone::Spine)]).normalized();
+    const Quat chest = (carry * w.f.rot[bi(Bone::Chest)]).normalized();
+    const Vec3 base = hips.pos_m + hips.rot * m.offset[bi(Bone::Spine)];
+    const Vec3 guess = base + spine * m.offset[bi(Bone::Chest)] + chest * m.offset[bi(Bone::Neck)];
+    Vec3 neck_joint;
+    const bool reachable = reach_head(base, guess, m.offset[bi(Bone::Head)].norm(), head.pos_m, neck_joint);
+    const Quat turn = Quat::FromTwoVectors(guess - base, neck_joint - base);
+    settle_ball(m, w, Bone::Spine, (turn * spine).normalized());
+    settle_ball(m, w, Bone::Chest, (turn * chest).normalized());
+    const Quat neck = (carry * w.f.rot[bi(Bone::Neck)]).normalized();
+    settle_ball(m, w, Bone::Neck, detail::aim(neck, m.rest_dir[bi(Bone::Neck)], head.pos_m - neck_joint));
     settle_ball(m, w, Bone::Head, head.rot);
     if (!reachable) out.flags |= kIkHeadMissed;
   }
@@ -318,23 +333,24 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     const Vec3 to_hand = chest.conjugate() * (target.pos_m - clav_pos);
     const Vec3 clav_dir = m.offset[bi(upper)].normalized();
     const Quat full = to_hand.norm() > 1e-9 ? Quat::FromTwoVectors(clav_dir, to_hand) : Quat::Identity();
-    const double raise = std::max(0.0, to_hand.normalized().z());
-    double k = std::min(1.0, o.clavicle_share + o.clavicle_raise_share * raise);
+    const double raise = smooth_max(0.0, to_hand.normalized().z(), kSoftness);
+    const double wanted = std::min(1.0, o.clavicle_share + o.clavicle_raise_share * raise);
     const auto shoulder_at = [&](double kk, Quat& local) {
       local = Quat::Identity().slerp(kk, full);
       sim::clamp_ball(m.limit[bi(clav)], local);
       return Vec3(clav_pos + chest * (local * m.offset[bi(upper)]));
     };
+    // The least share that brings the hand within reach (0 when it is), then
+    // the larger of the two, smoothly: a hard switch would jerk the shoulder
+    // every time a swinging arm straightens.
+    double lo = 0.0, hi = 1.0;
     Quat clav_local;
-    if ((target.pos_m - shoulder_at(k, clav_local)).norm() > reach) {
-      double lo = k, hi = 1.0;
-      for (int it = 0; it < kClavicleBisections; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        Quat tmp;
-        ((target.pos_m - shoulder_at(mid, tmp)).norm() > reach ? lo : hi) = mid;
-      }
-      k = hi;
+    if ((target.pos_m - shoulder_at(0.0, clav_local)).norm() <= reach) hi = 0.0;
+    for (int it = 0; it < kClavicleBisections && hi > 0.0; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      ((target.pos_m - shoulder_at(mid, clav_local)).norm() > reach ? lo : hi) = mid;
     }
+    const double k = std::min(1.0, smooth_max(wanted, hi, kSoftness));
     shoulder_at(k, clav_local);
     settle_ball(m, w, clav, (chest * clav_local).normalized());
     const Vec3 shoulder = joint_of(w, m, upper);
@@ -343,15 +359,19 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     // some of the anatomical pole (down, back, out); an elbow tracker wins.
     const Vec3 hand_dir = target.rot * m.rest_dir[bi(hand)];
     const Vec3 anatomic = chest * Vec3(-0.4, 0.3 * rest_arm.y(), -1.0);
-    Vec3 pole = -hand_dir + o.default_pole_weight * anatomic.normalized();
+    // Smoothed in the chest's frame: a hand's quick turns are the wrist's.
+    const Vec3 raw_pole = chest.conjugate() * (-hand_dir + o.default_pole_weight * anatomic.normalized());
+    if (!st.started) st.elbow_pole[s] = raw_pole;
+    st.elbow_pole[s] += smoothing(dt, o.elbow_smoothing_s) * (raw_pole - st.elbow_pole[s]);
+    Vec3 pole = chest * st.elbow_pole[s];
     IkState::Track& et = st.track[index(kElbow[s])];
     if (m.calibration.offset[index(kElbow[s])].valid && et.seen) {
       const TrackerPose e = detail::effective_pose(TrackerPose{shoulder + pole, Quat::Identity(), true}, dt, o, et,
                                                    out.use[index(kElbow[s])]);
       pole = e.pos_m - shoulder;
     }
-    detail::TwoBoneLimb limb{m.rest_dir[bi(upper)], m.rest_dir[bi(fore)], m.hinge_axis[bi(fore)], m.upper_arm_m[s],
-                             m.forearm_m[s]};
+    detail::TwoBoneLimb limb{m.rest_dir[bi(upper)], m.rest_dir[bi(fore)], m.hinge_axis[bi(fore)],
+                             m.upper_arm_m[s],      m.forearm_m[s],       o.arm_softness_m};
     detail::TwoBoneSolution sol = detail::solve_two_bone(limb, shoulder, target.pos_m, pole, anatomic);
     // An elbow the upper arm cannot twist to is turned about the shoulder-wrist
     // line until it can (the twist follows that turn almost one to one).
@@ -376,7 +396,6 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     }
     settle_hinge(m, w, fore, angle);
     settle_ball(m, w, hand, target.rot);
-    if (!sol.reached) out.flags |= kIkHandUnreachable;
   }
 
   // 5. Legs.
@@ -426,8 +445,8 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
                                                    out.use[index(kKnee[s])]);
       pole = k.pos_m - hip[s];
     }
-    detail::TwoBoneLimb limb{m.rest_dir[bi(thigh)], m.rest_dir[bi(shank)], m.hinge_axis[bi(shank)], m.thigh_m[s],
-                             m.shank_m[s]};
+    detail::TwoBoneLimb limb{m.rest_dir[bi(thigh)], m.rest_dir[bi(shank)], m.hinge_axis[bi(shank)],
+                             m.thigh_m[s],          m.shank_m[s],          o.leg_softness_m};
     const detail::TwoBoneSolution sol =
         detail::solve_two_bone(limb, hip[s], target.pos_m, pole, body_yaw * Vec3::UnitX());
     double angle = sol.hinge_rad;
@@ -439,7 +458,6 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     settle_hinge(m, w, shank, angle);
     settle_ball(m, w, foot, target.rot);
     settle_hinge(m, w, toes, 0.0);
-    if (!sol.reached) out.flags |= kIkFootUnreachable;
   }
   st.started = true;
 

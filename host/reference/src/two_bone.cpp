@@ -32,8 +32,10 @@ TwoBoneSolution solve_two_bone(const TwoBoneLimb& limb, const sim::Vec3& root, c
     dir = d / dist;
   }
   const double shortest = std::abs(a - b) + 1e-9, longest = a + b;
-  if (dist > longest) s.reached = false;
-  if (dist < shortest) s.reached = false;
+  s.reached = dist >= shortest && dist <= longest;
+  if (limb.soft_m > 0.0 && dist > longest - limb.soft_m) {
+    dist = longest - limb.soft_m * std::exp(-(dist - (longest - limb.soft_m)) / limb.soft_m);
+  }
   dist = std::clamp(dist, shortest, longest);
 
   sim::Vec3 p;

@@ -13,6 +13,12 @@ struct TwoBoneLimb {
   sim::Vec3 hinge;      // the middle joint's axis (upper bone's frame, unit), positive angle = flexion
   double upper_m = 0.0;
   double lower_m = 0.0;
+  // Soft reach: within this of full extension the limb straightens along an
+  // exponential, never quite reaching straight (the end then falls short by
+  // at most 0.37 of it). Near straight, the middle joint's position is the
+  // square root of the slack, so without this any jitter in the target's
+  // distance becomes a large jerk of the elbow or knee. 0: exact.
+  double soft_m = 0.0;
 };
 
 struct TwoBoneSolution {

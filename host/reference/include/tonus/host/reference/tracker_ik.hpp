@@ -47,10 +47,14 @@ struct IkOptions {
   double chest_share = 0.25;
   double neck_share = 0.6;
   double hands_heading_weight = 0.3;  // the hands' say in the body's heading, against the head's 1
+  double trunk_smoothing_s = 0.05;    // time constant of the head turn the trunk bones share (0: none)
   // Arms.
   double clavicle_share = 0.08;        // of the swing that would point the clavicle at the hand
   double clavicle_raise_share = 0.25;  // added in proportion to how far above the shoulder the hand is
   double default_pole_weight = 0.25;   // elbows: the anatomical pole (down, back) against the hand's
+  double arm_softness_m = 0.002;       // soft reach near a straight arm (the wrist short by at most 0.37 of it)
+  double leg_softness_m = 0.0;         // ... and leg (0: a standing leg straight, its foot on the floor)
+  double elbow_smoothing_s = 0.05;     // time constant of the elbows' pole (0: none)
   // Steps (3 points).
   double step_threshold_m = 0.12;  // a planted foot further than this from its place under the hip steps
   double step_turn_rad = 0.6;      // ... or turned further than this from the pelvis's heading
@@ -148,6 +152,8 @@ struct IkState {
   };
   std::array<Track, kTrackerCount> track{};
   double body_yaw_rad = 0.0;
+  sim::Quat trunk_turn = sim::Quat::Identity();  // the head's turn from the heading, smoothed
+  std::array<sim::Vec3, 2> elbow_pole{};         // in the chest's frame, smoothed
   sim::Vec3 last_pelvis = sim::Vec3::Zero();
   sim::Vec3 pelvis_velocity = sim::Vec3::Zero();
   struct Foot {
