@@ -15,7 +15,7 @@ for key in ("mpjpe_cm", "mpjpe_upper_cm", "mpjpe_lower_cm", "hand_error_max_mm",
 mapping = r["mapping"]
 for bone in ("Hips", "Head", "LeftHand", "RightHand", "LeftFoot", "RightFoot"):
     assert isinstance(mapping[bone], str) and mapping[bone], (bone, mapping.get(bone))
-assert [run["condition"] for run in r["runs"]] == ["clean", "noise", "dropouts"]
+assert [run["condition"] for run in r["runs"]] == ["clean", "noise", "dropouts", "noise_filtered"]
 clean = r["runs"][0]
 assert clean["mpjpe_cm"] == r["mpjpe_cm"]
 # Goals on a walk: 3 points at most 9 cm (half of Final IK's 18.1), 6 points at most 3 cm; the head on
@@ -27,6 +27,8 @@ if trackers == 3:
     assert r["head_error_max_mm"] <= 1.0, r["head_error_max_mm"]
 for run in r["runs"][1:]:
     assert run["mpjpe_cm"] >= 0.9 * clean["mpjpe_cm"], (run["condition"], run["mpjpe_cm"])
+noisy, filtered = r["runs"][1], r["runs"][3]
+assert filtered["jitter_ratio"] < 0.5 * noisy["jitter_ratio"], (filtered["jitter_ratio"], noisy["jitter_ratio"])
 print(f"tonus ik ({trackers} trackers): MPJPE {r['mpjpe_cm']:.2f} cm (upper {r['mpjpe_upper_cm']:.2f}, lower "
       f"{r['mpjpe_lower_cm']:.2f}), wrists within 1 mm {100 * clean['hand_within_1mm_share']:.1f} %, "
       f"jitter x{r['jitter_ratio']:.2f}")

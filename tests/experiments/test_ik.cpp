@@ -27,7 +27,7 @@ TEST_CASE("tonus ik: walks from 3 and 6 trackers meet the goals") {
       opt.trackers = trackers;
       const IkEvalResult r = run_ik_eval(opt);
       REQUIRE_MESSAGE(r.error.empty(), r.error);
-      REQUIRE(r.runs.size() == 3);
+      REQUIRE(r.runs.size() == 4);
       const IkRun& clean = r.runs[0];
       MESSAGE(clip << " " << trackers << " trackers: MPJPE " << clean.mpjpe_cm << " cm (upper " << clean.mpjpe_upper_cm
                    << ", lower " << clean.mpjpe_lower_cm << "), wrists within 1 mm " << clean.hand_within_1mm_share
@@ -44,6 +44,8 @@ TEST_CASE("tonus ik: walks from 3 and 6 trackers meet the goals") {
       // Noise and dropouts cost something, and nothing breaks.
       CHECK(r.runs[1].mpjpe_cm < clean.mpjpe_cm + 2.0);
       CHECK(r.runs[2].mpjpe_cm < 3.0 * clean.mpjpe_cm + 10.0);
+      // The input filter takes most of the noise's jitter out.
+      CHECK(r.runs[3].jitter_ratio < 0.5 * r.runs[1].jitter_ratio);
     }
   }
 }

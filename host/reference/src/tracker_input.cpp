@@ -30,6 +30,10 @@ bool read_sample(const TrackerPose& sample, const TrackerPose& offset, double dt
   if (usable) {
     TrackerPose s = sample;
     s.rot.normalize();
+    if (options.input_filter) {
+      // A sample after a loss starts the filter afresh (dt 0): no smoothing across the gap.
+      s = one_euro(s, track.lost_s > 0.0 ? 0.0 : dt_s, options.filter, track.filter);
+    }
     if (track.seen && track.lost_s > 0.0) track.recover_left_s = options.recover_s;
     track.target = compose(s, inverse(offset));
     track.target.valid = true;

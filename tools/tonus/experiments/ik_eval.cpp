@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <random>
 
 #include "tonus/host/balance/convert.hpp"
@@ -353,6 +352,12 @@ IkEvalResult run_ik_eval(const IkEvalOptions& opt) {
   for (const char* c : {"clean", "noise", "dropouts"}) {
     r.runs.push_back(run_condition(c, setup, *setup.ik, *setup.solved, opt));
   }
+  // The same noise through the solver's input filter (1-euro, default settings).
+  reference::IkModel filtered = *setup.ik;
+  filtered.options.input_filter = true;
+  IkRun run = run_condition("noise", setup, filtered, *setup.solved, opt);
+  run.condition = "noise_filtered";
+  r.runs.push_back(std::move(run));
   return r;
 }
 

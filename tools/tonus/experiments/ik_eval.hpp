@@ -33,7 +33,7 @@ struct IkEvalOptions {
 
 // One run of the solver over the clip.
 struct IkRun {
-  std::string condition;  // clean, noise, dropouts
+  std::string condition;  // clean, noise, dropouts, noise_filtered (the noise through the 1-euro input filter)
   std::size_t frames = 0;
   double mpjpe_cm = 0.0, mpjpe_upper_cm = 0.0, mpjpe_lower_cm = 0.0;
   double mpjpe_p95_cm = 0.0, mpjpe_max_cm = 0.0;             // of the per-frame mean
@@ -61,7 +61,7 @@ struct IkEvalResult {
   double frame_time_s = 0.0;
   double truth_height_m = 0.0, calibrated_height_m = 0.0, arm_scale = 0.0;
   int trackers = 3;
-  std::vector<IkRun> runs;  // clean, noise, dropouts
+  std::vector<IkRun> runs;  // clean, noise, dropouts, noise_filtered
   double source_jitter_mps3 = 0.0;
   std::vector<std::string> messages;
   std::string error;

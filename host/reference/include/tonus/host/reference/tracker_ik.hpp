@@ -33,6 +33,7 @@
 #include <string>
 
 #include "tonus/host/reference/calibration.hpp"
+#include "tonus/host/reference/one_euro.hpp"
 #include "tonus/host/reference/trackers.hpp"
 #include "tonus/sim/capacity.hpp"
 #include "tonus/sim/model.hpp"
@@ -67,6 +68,11 @@ struct IkOptions {
   // steps are the better guess (measured on real walks, docs/reference.md).
   double step_lead_s = 0.1;
   double velocity_time_constant_s = 0.1;  // smoothing of the pelvis's speed
+  // Input smoothing: the 1-euro filter (Casiez et al. 2012) on every tracker
+  // sample, for noisy trackers. Off by default: it adds lag (about
+  // 1 / (2 pi cutoff) at rest, less moving).
+  bool input_filter = false;
+  OneEuroParams filter;
   // Lost trackers.
   double hold_s = 0.25;    // a lost tracker is held this long ...
   double ease_s = 0.5;     // ... then eased to its neutral over this
@@ -143,9 +149,10 @@ struct IkState {
   bool started = false;
   double time_s = 0.0;
   struct Track {
-    TrackerPose target;  // the bone's last valid pose
-    TrackerPose shown;   // the pose used last frame (what recovery blends from)
-    TrackerPose held;    // the pose shown when the tracker was lost (what easing starts from)
+    TrackerPose target;   // the bone's last valid pose
+    TrackerPose shown;    // the pose used last frame (what recovery blends from)
+    TrackerPose held;     // the pose shown when the tracker was lost (what easing starts from)
+    OneEuroState filter;  // the input filter's memory (IkOptions::input_filter)
     double lost_s = 0.0;
     double recover_left_s = 0.0;
     bool seen = false;
