@@ -33,6 +33,9 @@ constexpr std::array<Tracker, 2> kKnee{Tracker::left_knee, Tracker::right_knee};
 constexpr int kClavicleBisections = 24;
 constexpr double kSoftness = 0.05;  // of the smooth maxima (shares, sines)
 constexpr int kTwistCorrections = 3;
+constexpr int kElbowScanSteps = 12;  // 15 degrees each: half a turn either way
+constexpr double kElbowScanStep_rad = std::numbers::pi / 12.0;
+constexpr int kElbowBisections = 16;
 constexpr double kReachedTolerance_m = 1e-3;
 constexpr double kPelvisKneeWeight = 0.5;
 constexpr double kTwistMargin_rad = 0.05;
@@ -376,15 +379,44 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     // An elbow the upper arm cannot twist to is turned about the shoulder-wrist
     // line until it can (the twist follows that turn almost one to one).
     const Vec3 line = target.pos_m - shoulder;
+    const sim::JointLimit& lim = m.limit[bi(upper)];
+    const auto local_of = [&](const detail::TwoBoneSolution& so) {
+      return Quat((w.f.rot[bi(clav)].conjugate() * so.upper).normalized());
+    };
     for (int it = 0; it < kTwistCorrections && line.norm() > 1e-6; ++it) {
-      const Quat local = (w.f.rot[bi(clav)].conjugate() * sol.upper).normalized();
-      const sim::JointLimit& lim = m.limit[bi(upper)];
-      const double twist = sim::swing_twist(local, lim.twist_axis).twist_rad;
+      const double twist = sim::swing_twist(local_of(sol), lim.twist_axis).twist_rad;
       const double excess =
           twist - std::clamp(twist, lim.lower_rad + kTwistMargin_rad, lim.upper_rad - kTwistMargin_rad);
       if (excess == 0.0) break;
       pole = Eigen::AngleAxisd(-excess, line.normalized()) * pole;
       sol = detail::solve_two_bone(limb, shoulder, target.pos_m, pole, anatomic);
+    }
+    // An upper arm past its swing cone (or still past its twist): the elbow
+    // is turned about the line to the nearest place inside both, found by a
+    // scan both ways, then bisection onto the boundary (so it moves smoothly).
+    const auto outside = [&](const Vec3& p) {
+      const detail::TwoBoneSolution so = detail::solve_two_bone(limb, shoulder, target.pos_m, p, anatomic);
+      const sim::SwingTwist sw = sim::swing_twist(local_of(so), lim.twist_axis);
+      return sw.swing_rad > lim.swing_max_rad || sw.twist_rad < lim.lower_rad || sw.twist_rad > lim.upper_rad;
+    };
+    if (line.norm() > 1e-6 && outside(pole)) {
+      const Vec3 axis = line.normalized();
+      double found = 0.0;
+      for (int step = 1; step <= kElbowScanSteps && found == 0.0; ++step) {
+        for (const double sign : {1.0, -1.0}) {
+          const double a = sign * step * kElbowScanStep_rad;
+          if (found == 0.0 && !outside(Eigen::AngleAxisd(a, axis) * pole)) found = a;
+        }
+      }
+      if (found != 0.0) {
+        double inside = found, beyond = found - std::copysign(kElbowScanStep_rad, found);
+        for (int it = 0; it < kElbowBisections; ++it) {
+          const double mid = 0.5 * (inside + beyond);
+          (outside(Eigen::AngleAxisd(mid, axis) * pole) ? beyond : inside) = mid;
+        }
+        pole = Eigen::AngleAxisd(inside, axis) * pole;
+        sol = detail::solve_two_bone(limb, shoulder, target.pos_m, pole, anatomic);
+      }
     }
     w.f.pos[bi(upper)] = shoulder;
     double angle = sol.hinge_rad;
