@@ -360,12 +360,24 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
 
     // Elbow: away from where the hand points (the least wrist bend), with
     // some of the anatomical pole (down, back, out); an elbow tracker wins.
+    // Only the parts across the shoulder-wrist line count, the hand's
+    // weighted by its own size: a hand pointing nearly along the arm says
+    // little about the elbow, and must not flip it.
     const Vec3 hand_dir = target.rot * m.rest_dir[bi(hand)];
     const Vec3 anatomic = chest * Vec3(-0.4, 0.3 * rest_arm.y(), -1.0);
+    Vec3 along = target.pos_m - shoulder;
+    along = along.norm() > 1e-9 ? Vec3(along.normalized()) : Vec3(chest * -Vec3::UnitZ());
+    const auto across_line = [&](const Vec3& v) { return Vec3(v - v.dot(along) * along); };
+    const Vec3 hand_part = across_line(-hand_dir);
+    const Vec3 raw_pole =
+        chest.conjugate() * (hand_part.norm() * hand_part + o.default_pole_weight * across_line(anatomic.normalized()));
     // Smoothed in the chest's frame: a hand's quick turns are the wrist's.
-    const Vec3 raw_pole = chest.conjugate() * (-hand_dir + o.default_pole_weight * anatomic.normalized());
-    if (!st.started) st.elbow_pole[s] = raw_pole;
-    st.elbow_pole[s] += smoothing(dt, o.elbow_smoothing_s) * (raw_pole - st.elbow_pole[s]);
+    // The smoothed pole is kept unit, so a weak cue (the two disagreeing, or
+    // both small) barely turns it and it never shrinks through zero (a flip).
+    const Vec3 anatomic_local = chest.conjugate() * anatomic.normalized();
+    if (!st.started || st.elbow_pole[s].norm() < 0.5) st.elbow_pole[s] = anatomic_local;
+    const Vec3 moved = st.elbow_pole[s] + smoothing(dt, o.elbow_smoothing_s) * (raw_pole - st.elbow_pole[s]);
+    if (moved.norm() > 1e-6) st.elbow_pole[s] = moved.normalized();
     Vec3 pole = chest * st.elbow_pole[s];
     IkState::Track& et = st.track[index(kElbow[s])];
     if (m.calibration.offset[index(kElbow[s])].valid && et.seen) {
