@@ -26,3 +26,9 @@ build/release/bin/tonus zmp tests/data/cmu_02_walk.bvh -o build/release/cmu_02_w
 # with a JSON report and an SVG plot.
 build/release/bin/tonus experiment cube-on-hand --json build/release/cube_on_hand.json \
   --svg build/release/cube_on_hand.svg
+
+# Full-body pose from a headset and two controllers: the bundled CMU walk's
+# own trackers (synthesized at fixed offsets), calibrated from a T-pose and
+# solved by IK, against the clip's full body; clean, noisy and with dropouts.
+build/release/bin/tonus ik tests/data/cmu_02_walk.bvh --trackers 3 --json build/release/cmu_02_walk_ik.json \
+  --svg build/release/cmu_02_walk_ik.svg
