@@ -251,18 +251,17 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
   const Quat heading = yaw_quat(yaw);
 
   // 3. Trunk: each bone takes its share of the head's turn from the heading.
-  // The trunk follows the head's turn smoothed (a head's quick nods and
-  // shakes are the neck's); the neck and head follow it as it is.
+  // The trunk and neck share the head's turn smoothed (its quick nods and
+  // shakes are the head joint's); the head itself is exact.
   const Quat head_rel = (heading.conjugate() * head.rot).normalized();
   if (!st.started) st.trunk_turn = head_rel;
   if (st.trunk_turn.dot(head_rel) < 0.0) st.trunk_turn.coeffs() = -st.trunk_turn.coeffs();
   st.trunk_turn = st.trunk_turn.slerp(smoothing(dt, o.trunk_smoothing_s), head_rel).normalized();
   const auto share = [&](double s) { return (heading * Quat::Identity().slerp(s, st.trunk_turn)).normalized(); };
-  const auto head_share = [&](double s) { return (heading * Quat::Identity().slerp(s, head_rel)).normalized(); };
   w.f.rot[bi(Bone::Hips)] = share(o.pelvis_share);
   settle_ball(m, w, Bone::Spine, share(o.spine_share));
   settle_ball(m, w, Bone::Chest, share(o.chest_share));
-  settle_ball(m, w, Bone::Neck, head_share(o.neck_share));
+  settle_ball(m, w, Bone::Neck, share(o.neck_share));
   settle_ball(m, w, Bone::Head, head.rot);
   // The pelvis that puts the head joint exactly on its target.
   Vec3 pelvis = head.pos_m;
