@@ -39,7 +39,7 @@ void solve(benchmark::State& state, const std::string& clip, int trackers) {
   // Each solve timed on its own (manual time), so the tails are per solve.
   std::vector<double> us;
   us.reserve(1 << 22);
-  for (auto _ : state) {
+  for (auto _ : state) {  // NOLINT(clang-analyzer-deadcode.DeadStores): Google Benchmark's loop idiom
     reference::TrackerFrame frame = setup.trackers[f];
     frame.time_s = t;
     const auto t0 = std::chrono::steady_clock::now();

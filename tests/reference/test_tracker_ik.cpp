@@ -335,16 +335,16 @@ TEST_CASE("tracker IK: bad input is ignored, held, eased, flagged, never a NaN")
     TrackerFrame f = pose_truth(rig, q, 0.0);
     const Vec3 held = bone_target(rig, f, Tracker::left_hand);
     solve_ik(*rig.ik, st, f, out);
-    double t = 0.0;
-    for (; t < 0.15; t += 0.01) {  // within the hold time
-      f.time_s = t + 0.01;
+    int tick = 0;                // 10 ms each
+    for (; tick < 15; ++tick) {  // within the hold time
+      f.time_s = 0.01 * (tick + 1);
       f[Tracker::left_hand].valid = false;
       solve_ik(*rig.ik, st, f, out);
     }
     CHECK(out.use[index(Tracker::left_hand)] == TrackerUse::held);
     CHECK((solved_joints(rig, out.qpos)[sim::index(Bone::LeftHand)] - held).norm() < kMm);
-    for (; t < 0.8; t += 0.01) {  // past hold + ease
-      f.time_s = t + 0.01;
+    for (; tick < 80; ++tick) {  // past hold + ease
+      f.time_s = 0.01 * (tick + 1);
       f[Tracker::left_hand].valid = false;
       solve_ik(*rig.ik, st, f, out);
     }
@@ -353,7 +353,7 @@ TEST_CASE("tracker IK: bad input is ignored, held, eased, flagged, never a NaN")
     const auto j = solved_joints(rig, out.qpos);
     // Hanging: the wrist about an arm's length below the shoulder.
     CHECK(j[sim::index(Bone::LeftUpperArm)].z() - j[sim::index(Bone::LeftHand)].z() > 0.45);
-    const TrackerFrame back = pose_truth(rig, q, t + 0.01);
+    const TrackerFrame back = pose_truth(rig, q, 0.01 * (tick + 1));
     f = back;
     solve_ik(*rig.ik, st, f, out);
     CHECK(out.use[index(Tracker::left_hand)] == TrackerUse::recovering);

@@ -36,7 +36,11 @@ int run_ik_command(const IkCommandOptions& opt) {
     fmt::print("tonus ik: {} ({} trackers)\n", r.clip, r.trackers);
     std::string bones;
     for (const auto& [bone, joint] : r.mapping) {
-      if (!joint.empty()) bones += (bones.empty() ? "" : ", ") + bone + "=" + joint;
+      if (joint.empty()) continue;
+      if (!bones.empty()) bones += ", ";
+      bones += bone;
+      bones += '=';
+      bones += joint;
     }
     fmt::print("  skeleton: {}; bones: {}\n", r.convention, bones);
     fmt::print("  stature: clip {:.3f} m, calibrated from a T-pose {:.3f} m (arm scale {:.3f})\n", r.truth_height_m,

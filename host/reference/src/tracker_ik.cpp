@@ -538,18 +538,16 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     }
   }
 
-  const auto put_quat = [&](int adr, const Quat& q) {
-    auto at = [&](int k) -> double& { return out.qpos[static_cast<std::size_t>(adr + k)]; };
+  const auto put_quat = [&](int address, const Quat& q) {
+    const auto a = static_cast<std::size_t>(address);
     Quat u = q.normalized();
-    const double dot = st.last_qpos[static_cast<std::size_t>(adr)] * u.w() +
-                       st.last_qpos[static_cast<std::size_t>(adr + 1)] * u.x() +
-                       st.last_qpos[static_cast<std::size_t>(adr + 2)] * u.y() +
-                       st.last_qpos[static_cast<std::size_t>(adr + 3)] * u.z();
+    const double dot = st.last_qpos[a] * u.w() + st.last_qpos[a + 1] * u.x() + st.last_qpos[a + 2] * u.y() +
+                       st.last_qpos[a + 3] * u.z();
     if (dot < 0.0) u.coeffs() = -u.coeffs();
-    at(0) = u.w();
-    at(1) = u.x();
-    at(2) = u.y();
-    at(3) = u.z();
+    out.qpos[a] = u.w();
+    out.qpos[a + 1] = u.x();
+    out.qpos[a + 2] = u.y();
+    out.qpos[a + 3] = u.z();
   };
   out.qpos[0] = pelvis_now.x();
   out.qpos[1] = pelvis_now.y();
