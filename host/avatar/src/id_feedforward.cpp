@@ -2,9 +2,8 @@
 #include "id_feedforward.hpp"
 
 #include <algorithm>
-#include <cmath>
+#include <utility>
 
-#include "reference_ops.hpp"
 #include "tonus/sim/step.hpp"
 
 namespace tonus::avatar::detail {
@@ -17,70 +16,33 @@ std::unique_ptr<IdFeedforward> IdFeedforward::create(const sim::Model& model, do
     error = "id_lag_ticks must be in 1.." + std::to_string(derivatives::FixedLag::kMaxLag);
     return nullptr;
   }
-  derivatives::Params p;
-  p.method = derivatives::Method::kalman;
-  p.cutoff_hz = cutoff_hz;
-  auto made = derivatives::FixedLag::create(model.timestep_s, p, static_cast<size_t>(lag));
+  reference::ReferenceVelocity::Created made =
+      reference::ReferenceVelocity::create(model, model.timestep_s, cutoff_hz, lag);
   if (!made) {
     error = "id_cutoff_hz: the smoother refuses it for this time step";
     return nullptr;
   }
   std::unique_ptr<IdFeedforward> f(new IdFeedforward());
-  f->lag_ = lag;
-  f->smoothers_.assign(static_cast<size_t>(model.nv), *made.smoother);
-  f->history_.assign(static_cast<size_t>(lag) + 1, model.qpos0);
+  f->velocity_ = std::move(made.velocity);
   f->scratch_ = sim::make_data(model);
   return f;
 }
 
-void IdFeedforward::reset() {
-  for (auto& s : smoothers_) s.reset();
-  pushed_ = 0;
-  coordinate_.fill(0.0);
-}
+void IdFeedforward::reset() { velocity_->reset(); }
 
 bool IdFeedforward::push(const sim::Model& model, const ReferencePose& ref, ReferencePose& delayed,
                          std::span<double> tau) {
   const auto nv = static_cast<size_t>(model.nv);
-  // The running coordinates: positions as they are, rotations as summed increments.
-  std::array<double, sim::kMaxDofs> increment{};
-  if (pushed_ > 0) difference(model, last_qpos_, ref.qpos, 1.0, increment);
-  for (int i = 0; i < model.nbody; ++i) {
-    const sim::Body& b = model.bodies[static_cast<size_t>(i)];
-    const auto a = static_cast<size_t>(b.qpos_adr);
-    const auto d = static_cast<size_t>(b.dof_adr);
-    switch (b.joint) {
-      case sim::JointType::free:
-        for (size_t k = 0; k < 3; ++k) coordinate_[d + k] = ref.qpos[a + k];
-        for (size_t k = 3; k < 6; ++k) coordinate_[d + k] += increment[d + k];
-        break;
-      case sim::JointType::ball:
-        for (size_t k = 0; k < 3; ++k) coordinate_[d + k] += increment[d + k];
-        break;
-      case sim::JointType::hinge: coordinate_[d] = ref.qpos[a]; break;
-      case sim::JointType::fixed: break;
-    }
-  }
-  last_qpos_ = ref.qpos;
-  history_[pushed_ % history_.size()] = ref.qpos;
-  ++pushed_;
-
-  bool valid = true;
-  for (size_t d = 0; d < nv; ++d) {
-    const derivatives::Estimate e = smoothers_[d].push(coordinate_[d]);
-    valid = valid && e.valid;
-    delayed.qvel[d] = e.valid ? e.vel : 0.0;
-    qacc_[d] = e.valid ? e.acc : 0.0;
-  }
-  const size_t back = std::min(pushed_ - 1, static_cast<size_t>(lag_));
-  delayed.qpos = history_[(pushed_ - 1 - back) % history_.size()];
+  const bool valid = velocity_->push(std::span<const double>(ref.qpos.data(), static_cast<size_t>(model.nq)), out_);
+  delayed.qpos = out_.qpos;
+  std::copy_n(out_.qvel.begin(), nv, delayed.qvel.begin());
   delayed.has_velocity = true;
 
   sim::Data& s = *scratch_;
   s.qpos = delayed.qpos;
   std::copy_n(delayed.qvel.begin(), nv, s.qvel.begin());
   sim::forward_kinematics(model, s);
-  sim::inverse_dynamics(model, s, qacc_, tau);
+  sim::inverse_dynamics(model, s, out_.qacc, tau);
   for (int k = 0; k < model.bodies[0].dof_num; ++k) tau[static_cast<size_t>(k)] = 0.0;  // the root is prescribed
   return valid;
 }

@@ -1,21 +1,17 @@
 // Variant (b) of the feedforward: inverse dynamics (RNEA) of the reference,
-// its velocities and accelerations from the fixed-lag Kalman smoother of
-// host/derivatives, so no second simulation runs. The smoother answers for
-// the sample `lag` ticks back, so the reference is followed that late.
-//
-// Each dof is smoothed as a scalar: hinge angles and root positions as they
-// are; ball joints and the root's rotation as the running sum of their
-// body-frame rotation increments, whose derivative is the body-frame angular
-// velocity the model's qvel holds (and its derivative, qacc).
+// its velocities and accelerations from the fixed-lag Kalman smoother
+// (reference::ReferenceVelocity, host/reference), so no second simulation
+// runs. The smoother answers for the sample `lag` ticks back, so the reference
+// is followed that late.
 #pragma once
 
-#include <array>
 #include <memory>
+#include <optional>
+#include <span>
 #include <string>
-#include <vector>
 
 #include "tonus/host/avatar/reference.hpp"
-#include "tonus/host/derivatives/fixed_lag.hpp"
+#include "tonus/host/reference/reference_velocity.hpp"
 #include "tonus/sim/data.hpp"
 
 namespace tonus::avatar::detail {
@@ -37,13 +33,8 @@ class IdFeedforward {
  private:
   IdFeedforward() = default;
 
-  int lag_ = 0;
-  std::vector<derivatives::FixedLag> smoothers_;            // one per dof, made once
-  std::vector<std::array<double, sim::kMaxQpos>> history_;  // the last lag + 1 references (ring)
-  std::size_t pushed_ = 0;
-  std::array<double, sim::kMaxDofs> coordinate_{};  // the running coordinates
-  std::array<double, sim::kMaxQpos> last_qpos_{};
-  std::array<double, sim::kMaxDofs> qacc_{};
+  std::optional<reference::ReferenceVelocity> velocity_;  // made once
+  reference::ReferenceVelocity::Output out_;
   std::unique_ptr<sim::Data> scratch_;
 };
 
