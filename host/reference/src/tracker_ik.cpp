@@ -30,12 +30,12 @@ constexpr std::array<Tracker, 2> kHand{Tracker::left_hand, Tracker::right_hand};
 constexpr std::array<Tracker, 2> kFootTracker{Tracker::left_foot, Tracker::right_foot};
 constexpr std::array<Tracker, 2> kElbow{Tracker::left_elbow, Tracker::right_elbow};
 constexpr std::array<Tracker, 2> kKnee{Tracker::left_knee, Tracker::right_knee};
-constexpr int kClavicleBisections = 24;
-constexpr double kSoftness = 0.05;  // of the smooth maxima (shares, sines)
+constexpr int kClavicleBisections = 14;  // the share to 1e-4
+constexpr double kSoftness = 0.05;       // of the smooth maxima (shares, sines)
 constexpr int kTwistCorrections = 3;
-constexpr int kElbowScanSteps = 12;  // 15 degrees each: half a turn either way
-constexpr double kElbowScanStep_rad = std::numbers::pi / 12.0;
-constexpr int kElbowBisections = 16;
+constexpr int kElbowScanSteps = 6;  // 30 degrees each: half a turn either way
+constexpr double kElbowScanStep_rad = std::numbers::pi / 6.0;
+constexpr int kElbowBisections = 10;  // to 0.03 degrees
 constexpr double kReachedTolerance_m = 1e-3;
 constexpr double kPelvisKneeWeight = 0.5;
 constexpr double kTwistMargin_rad = 0.05;
@@ -334,12 +334,18 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     // a raised hand, and as much as the reach needs (bisection).
     const Vec3 to_hand = chest.conjugate() * (target.pos_m - clav_pos);
     const Vec3 clav_dir = m.offset[bi(upper)].normalized();
-    const Quat full = to_hand.norm() > 1e-9 ? Quat::FromTwoVectors(clav_dir, to_hand) : Quat::Identity();
+    // The turn toward the hand is a pure swing of the clavicle (about an axis
+    // across its twist axis, its own direction), so a share of it is that
+    // share of the angle, and the swing cone caps the share: no clamp inside
+    // the bisection below.
+    const Eigen::AngleAxisd full(to_hand.norm() > 1e-9 ? Quat::FromTwoVectors(clav_dir, to_hand) : Quat::Identity());
+    const double cap = full.angle() > m.limit[bi(clav)].swing_max_rad && m.limit[bi(clav)].enabled
+                           ? m.limit[bi(clav)].swing_max_rad / full.angle()
+                           : 1.0;
     const double raise = smooth_max(0.0, to_hand.normalized().z(), kSoftness);
     const double wanted = std::min(1.0, o.clavicle_share + o.clavicle_raise_share * raise);
     const auto shoulder_at = [&](double kk, Quat& local) {
-      local = Quat::Identity().slerp(kk, full);
-      sim::clamp_ball(m.limit[bi(clav)], local);
+      local = Quat(Eigen::AngleAxisd(std::min(kk, cap) * full.angle(), full.axis()));
       return Vec3(clav_pos + chest * (local * m.offset[bi(upper)]));
     };
     // The least share that brings the hand within reach (0 when it is), then
