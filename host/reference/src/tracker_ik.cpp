@@ -278,8 +278,11 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     const TrackerPose hips = detail::effective_pose(estimate, dt, o, waist, out.use[index(Tracker::waist)]);
     w.f.pos[0] = hips.pos_m;
     w.f.rot[0] = hips.rot;
-    // Start from the 3-point trunk's shape, carried to the new pelvis.
-    const Quat carry = (hips.rot * share(o.pelvis_share).conjugate()).normalized();
+    // Start from the 3-point trunk's shape, carried to the new pelvis and
+    // turned with it by a share: the thorax turns against the pelvis in a
+    // walk, so carrying it whole passes the pelvis's sway up the spine.
+    const Quat carry =
+        Quat::Identity().slerp(o.trunk_follows_pelvis, (hips.rot * share(o.pelvis_share).conjugate()).normalized());
     const Quat spine = (carry * w.f.rot[bi(Bone::Spine)]).normalized();
     const Quat chest = (carry * w.f.rot[bi(Bone::Chest)]).normalized();
     const Vec3 base = hips.pos_m + hips.rot * m.offset[bi(Bone::Spine)];
