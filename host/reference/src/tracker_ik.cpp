@@ -489,8 +489,13 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     // the pelvis's.
     const Vec3 foot_fwd = horizontal(target.rot * Vec3::UnitX()) + horizontal(target.rot * Vec3::UnitZ());
     const Vec3 pelvis_fwd = horizontal(w.f.rot[0] * Vec3::UnitX());
-    Vec3 pole = (foot_fwd.norm() > 1e-6 ? Vec3(foot_fwd.normalized()) : Vec3::Zero()) +
-                kPelvisKneeWeight * (pelvis_fwd.norm() > 1e-6 ? Vec3(pelvis_fwd.normalized()) : Vec3::Zero());
+    const Vec3 raw_knee = (foot_fwd.norm() > 1e-6 ? Vec3(foot_fwd.normalized()) : Vec3::Zero()) +
+                          kPelvisKneeWeight * (pelvis_fwd.norm() > 1e-6 ? Vec3(pelvis_fwd.normalized()) : Vec3::Zero());
+    // Smoothed and kept unit, as the elbows' (a foot's quick turns are the ankle's).
+    if (!st.started || st.knee_pole[s].norm() < 0.5) st.knee_pole[s] = body_yaw * Vec3::UnitX();
+    const Vec3 knee_moved = st.knee_pole[s] + smoothing(dt, o.knee_smoothing_s) * (raw_knee - st.knee_pole[s]);
+    if (knee_moved.norm() > 1e-6) st.knee_pole[s] = knee_moved.normalized();
+    Vec3 pole = st.knee_pole[s];
     IkState::Track& kt = st.track[index(kKnee[s])];
     if (m.calibration.offset[index(kKnee[s])].valid && kt.seen) {
       const TrackerPose k = detail::effective_pose(TrackerPose{hip[s] + pole, Quat::Identity(), true}, dt, o, kt,

@@ -57,6 +57,7 @@ struct IkOptions {
   double arm_softness_m = 0.002;       // soft reach near a straight arm (the wrist short by at most 0.37 of it)
   double leg_softness_m = 0.0;         // ... and leg (0: a standing leg straight, its foot on the floor)
   double elbow_smoothing_s = 0.05;     // time constant of the elbows' pole (0: none)
+  double knee_smoothing_s = 0.05;      // ... and the knees'
   // Steps (3 points).
   double step_threshold_m = 0.12;  // a planted foot further than this from its place under the hip steps
   double step_turn_rad = 0.6;      // ... or turned further than this from the pelvis's heading
@@ -161,7 +162,8 @@ struct IkState {
   std::array<Track, kTrackerCount> track{};
   double body_yaw_rad = 0.0;
   sim::Quat trunk_turn = sim::Quat::Identity();  // the head's turn from the heading, smoothed
-  std::array<sim::Vec3, 2> elbow_pole{};         // in the chest's frame, smoothed
+  std::array<sim::Vec3, 2> elbow_pole{};         // in the chest's frame, smoothed, unit
+  std::array<sim::Vec3, 2> knee_pole{};          // in the world, smoothed, unit
   sim::Vec3 last_pelvis = sim::Vec3::Zero();
   sim::Vec3 pelvis_velocity = sim::Vec3::Zero();
   struct Foot {
