@@ -139,6 +139,7 @@ IkRun run_condition(const std::string& condition, const IkSetup& truth, const re
       ++run.flagged_frames;
     }
     if (out.flags & reference::kIkHandUnreachable) ++run.unreachable_frames;
+    if (out.flags & reference::kIkFootUnreachable) ++run.foot_unreachable_frames;
 
     // The solution through sim's kinematics, not the solver's own.
     data->qpos = out.qpos;

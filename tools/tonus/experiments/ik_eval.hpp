@@ -46,7 +46,7 @@ struct IkRun {
   double jitter_mps3 = 0.0;         // mean joint jerk, m/s^3
   double jitter_ratio = 0.0;        // over the clip's
   double velocity_error_mps = 0.0;  // mean per-joint velocity error
-  std::uint64_t steps = 0, clamped_frames = 0, flagged_frames = 0, unreachable_frames = 0;
+  std::uint64_t steps = 0, clamped_frames = 0, flagged_frames = 0, unreachable_frames = 0, foot_unreachable_frames = 0;
   double solve_mean_us = 0.0, solve_p99_us = 0.0, solve_max_us = 0.0;
   std::array<double, 21> joint_error_cm{};                // mean per joint (Bone order)
   std::array<double, 21> joint_jitter_ratio{};            // per joint, over the clip's

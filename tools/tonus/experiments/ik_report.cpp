@@ -28,6 +28,7 @@ nlohmann::json run_json(const IkRun& r) {
           {"clamped_frames", r.clamped_frames},
           {"flagged_frames", r.flagged_frames},
           {"hand_unreachable_frames", r.unreachable_frames},
+          {"foot_unreachable_frames", r.foot_unreachable_frames},
           {"solve_mean_us", r.solve_mean_us},
           {"solve_p99_us", r.solve_p99_us},
           {"solve_max_us", r.solve_max_us}};
