@@ -2,6 +2,8 @@
 // record (round trip, corrupt, old version, torn newest record).
 #include <doctest/doctest.h>
 
+#include <limits>
+
 #include "sim_hal.hpp"
 #include "tonus/firmware/calibration.hpp"
 #include "tonus/firmware/nv_record.hpp"
@@ -164,4 +166,34 @@ TEST_CASE("persisted record: round trip, corruption, old version, torn newest re
     REQUIRE(load_persisted(flash, out) == LoadResult::loaded);
     CHECK(out == b);
   }
+}
+
+TEST_CASE("a baseline above the reference never sends the levels to full scale") {
+  // A stored or measured calibration whose reference is not above its baseline
+  // used to divide by 1e-6: any effort read as full scale.
+  Calibration c = default_calibration(FrontEnd{});
+  c.baseline[0] = 300.0F;
+  c.reference[0] = 200.0F;
+  CHECK(normalise(c, 0, 310.0F) == 0.0F);
+  c.reference[0] = 300.5F;  // under a count of span
+  CHECK(normalise(c, 0, 310.0F) == 0.0F);
+  c.reference[0] = std::numeric_limits<float>::quiet_NaN();  // a corrupt record
+  CHECK(normalise(c, 0, 310.0F) == 0.0F);
+
+  // A rest phase that finds the performer's rest above the old MVC: the MVC is
+  // invalidated and the reference raised to the least an MVC could be.
+  Calibrator cal;
+  Calibration live = default_calibration(FrontEnd{});
+  cal.start(phase(proto::CalibrationPhase::rest), 1000.0F, 0);
+  feed(cal, live, 10.0F, 1000);
+  cal.start(phase(proto::CalibrationPhase::max_contraction), 1000.0F, 0);
+  feed(cal, live, 100.0F, 1000);
+  REQUIRE(live.calibrated_mask() == 0xFF);
+  cal.start(phase(proto::CalibrationPhase::rest), 1000.0F, 0);
+  feed(cal, live, 120.0F, 1000);  // noisier electrodes: rest above the old MVC
+  CHECK(cal.status(live).state == proto::CalibrationState::done);
+  CHECK(live.calibrated_mask() == 0);
+  CHECK(live.reference[0] >= kMvcOverRest * live.baseline[0]);
+  CHECK(normalise(live, 0, 126.0F) == doctest::Approx(0.05F).epsilon(0.02));  // 5 % above rest: small
+  CHECK(normalise(live, 0, 120.0F) == 0.0F);
 }

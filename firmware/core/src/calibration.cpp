@@ -97,9 +97,12 @@ void Calibrator::finish(Calibration& live) {
       if (phase_ == proto::CalibrationPhase::rest) {
         next.baseline[ch] = static_cast<float>(sum_[ch] / valid_[ch]);
         next.baseline_mask = static_cast<std::uint16_t>(next.baseline_mask | bit);
-        // A new baseline invalidates an MVC that no longer clears it.
+        // A new baseline invalidates an MVC that no longer clears it; the
+        // reference is then raised to the least an MVC could be, so the
+        // channel keeps a sane scale (not a span near zero) until one is measured.
         if (next.reference[ch] < kMvcOverRest * next.baseline[ch]) {
           next.reference_mask = static_cast<std::uint16_t>(next.reference_mask & ~bit);
+          next.reference[ch] = kMvcOverRest * next.baseline[ch] + kMinSpanCounts;
         }
         any = true;
       } else if (peak_[ch] >= kMvcOverRest * next.baseline[ch] && peak_[ch] > next.baseline[ch] + 1.0F) {

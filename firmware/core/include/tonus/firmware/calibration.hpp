@@ -43,10 +43,15 @@ struct Calibration {
 
 Calibration default_calibration(const FrontEnd& fe);
 
+// A reference closer to the baseline than this (ADC counts) gives no usable
+// scale: such a channel reads 0 (no effort) rather than full scale.
+inline constexpr float kMinSpanCounts = 1.0F;
+
 // Envelope in units of the channel's reference (0 at baseline, 1 at MVC), >= 0.
 inline float normalise(const Calibration& c, std::size_t ch, float envelope) {
   const float span = c.reference[ch] - c.baseline[ch];
-  const float v = (envelope - c.baseline[ch]) / (span > 1e-6F ? span : 1e-6F);
+  if (!(span >= kMinSpanCounts)) return 0.0F;  // also a NaN from a corrupt record
+  const float v = (envelope - c.baseline[ch]) / span;
   return v > 0.0F ? v : 0.0F;
 }
 
