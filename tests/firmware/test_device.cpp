@@ -514,3 +514,48 @@ TEST_CASE("CAN: segmented request and response, stream cycles and heartbeat") {
   }
   CHECK(heartbeats == 1);
 }
+
+TEST_CASE("CAN: a set_config that changes the node id is answered from the old id, then the new one serves") {
+  Bench b(spec(Scenario::rest, 2.0F));
+  hal::Board board = b.board();
+  Device dev(board);
+  dev.boot();
+  b.run_for(dev, 0.05F);
+  const std::uint8_t old_id = dev.config().can_node_id;
+  const std::uint8_t new_id = static_cast<std::uint8_t>(old_id == 7 ? 8 : 7);  // ids run 0..31
+  // Sends `req` over CAN to `to`; returns the response reassembled on `from`, if any.
+  const auto ask_can = [&](const proto::Request& req, std::uint8_t to, std::uint8_t from) {
+    std::array<std::uint8_t, proto::kMaxMessageSize> bytes{};
+    std::size_t n = 0;
+    REQUIRE(proto::encode_request(req, bytes, n) == proto::Error::ok);
+    std::array<proto::CanFrame, proto::can::kMaxSegments> frames{};
+    std::size_t count = 0;
+    REQUIRE(proto::can::segment(std::span<const std::uint8_t>(bytes).first(n), proto::can::Function::request, to,
+                                frames, count) == proto::Error::ok);
+    for (std::size_t k = 0; k < count; ++k) b.can.inbox.push_back(frames[k]);
+    b.can.sent.clear();
+    b.step(dev);
+    proto::can::Reassembler reasm(proto::can::Function::response, from);
+    std::optional<proto::Response> out;
+    for (const proto::CanFrame& f : b.can.sent) {
+      bool complete = false;
+      if (reasm.push(f, complete) != proto::Error::ok || !complete) continue;
+      proto::Response rsp{};
+      REQUIRE(proto::decode_response(reasm.message(), rsp) == proto::Error::ok);
+      out = rsp;
+    }
+    return out;
+  };
+  proto::DeviceConfig cfg = dev.config();
+  cfg.can_node_id = new_id;
+  const auto answer = ask_can(request(proto::Opcode::set_config, 9, cfg), old_id, old_id);
+  REQUIRE(answer.has_value());  // before the fix it came from the new id: the host waiting on the old one timed out
+  CHECK(answer->token == 9);
+  CHECK(answer->status == proto::Status::ok);
+  CHECK(dev.config().can_node_id == new_id);
+  // From now on the device listens and answers on the new id only.
+  const auto next = ask_can(proto::make_request(proto::Opcode::get_config, 10), new_id, new_id);
+  REQUIRE(next.has_value());
+  CHECK(next->token == 10);
+  CHECK_FALSE(ask_can(proto::make_request(proto::Opcode::get_config, 11), old_id, old_id).has_value());
+}

@@ -294,6 +294,9 @@ void Device::receive(std::span<const std::uint8_t> message, Link link, std::uint
   proto::Request req{};
   const proto::Error e = proto::decode_request(message, req);
   proto::Response rsp{};
+  // The answer leaves from the id the request was sent to, even when the
+  // request changes it (set_config of can_node_id): the host waits there.
+  const std::uint8_t answer_node = config_.can_node_id;
   if (e == proto::Error::ok) {
     handle(req, rx_us, rsp);
   } else {
@@ -309,11 +312,11 @@ void Device::receive(std::span<const std::uint8_t> message, Link link, std::uint
     if (e == proto::Error::bad_version) s = Status::bad_version;
     rsp = proto::make_response(header, s);
   }
-  reply(rsp, link);
+  reply(rsp, link, answer_node);
   after_reply(link);
 }
 
-void Device::reply(const proto::Response& rsp, Link link) {
+void Device::reply(const proto::Response& rsp, Link link, std::uint8_t can_node) {
   if (link == Link::hid) {
     proto::hid::Report r{};
     if (proto::hid::pack_response(rsp, r) != proto::Error::ok || !board_.hid->send_input(r)) ++stats_.tx_dropped;
@@ -324,8 +327,8 @@ void Device::reply(const proto::Response& rsp, Link link) {
   std::array<proto::CanFrame, proto::can::kMaxSegments> frames{};
   std::size_t count = 0;
   if (proto::encode_response(rsp, bytes, n) != proto::Error::ok ||
-      proto::can::segment(std::span<const std::uint8_t>(bytes).first(n), proto::can::Function::response,
-                          config_.can_node_id, frames, count) != proto::Error::ok) {
+      proto::can::segment(std::span<const std::uint8_t>(bytes).first(n), proto::can::Function::response, can_node,
+                          frames, count) != proto::Error::ok) {
     ++stats_.tx_dropped;
     return;
   }

@@ -77,7 +77,8 @@ class Device {
   void poll_hid();
   void poll_can();
   void receive(std::span<const std::uint8_t> message, Link link, std::uint64_t rx_us);
-  void reply(const proto::Response& rsp, Link link);
+  // Sends a response; over CAN from `can_node`.
+  void reply(const proto::Response& rsp, Link link, std::uint8_t can_node);
   void after_reply(Link link);
   void send_heartbeat(std::uint64_t now_us);
   void update_led();
