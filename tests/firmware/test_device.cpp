@@ -559,3 +559,49 @@ TEST_CASE("CAN: a set_config that changes the node id is answered from the old i
   CHECK(next->token == 10);
   CHECK_FALSE(ask_can(proto::make_request(proto::Opcode::get_config, 11), old_id, old_id).has_value());
 }
+
+TEST_CASE("a stalled sampler is restarted once, then reported as a fault and the watchdog left to reset the chip") {
+  Bench b(spec(Scenario::rest, 8.0F));
+  hal::Board board = b.board();
+  Device dev(board);
+  dev.boot();
+  b.run_for(dev, 0.5F);
+  const int starts = b.sampler.starts();
+  // The main loop keeps running, but no block arrives (DMA stuck).
+  const auto heartbeat_state = [&] {
+    std::optional<proto::can::NodeState> state;
+    for (const proto::CanFrame& f : b.can.sent) {
+      proto::can::Heartbeat hb{};
+      if (proto::can::decode_heartbeat(f, hb) == proto::Error::ok) state = hb.state;
+    }
+    b.can.sent.clear();
+    return state;
+  };
+  const auto idle = [&](double seconds) {
+    const std::uint64_t until = b.clock.now_us() + static_cast<std::uint64_t>(seconds * 1e6);
+    while (b.clock.now_us() < until) {
+      b.clock.advance_to(b.clock.now_us() + 10000);
+      dev.poll();
+    }
+  };
+  b.can.sent.clear();
+  idle(0.25);
+  CHECK(b.sampler.starts() == starts + 1);  // restarted once
+  CHECK_FALSE(dev.sampler_stalled());
+  const std::uint64_t kicks_before = b.watchdog.kicks();
+  idle(1.5);
+  CHECK(dev.sampler_stalled());
+  CHECK(b.sampler.starts() == starts + 1);                   // no restart storm
+  CHECK(heartbeat_state() == proto::can::NodeState::fault);  // was "running" before the fix
+  CHECK(b.led.pattern() == hal::LedPattern::fault);
+  CHECK(b.watchdog.kicks() < kicks_before + 25);  // kicks stopped once stalled (within 0.2 s)
+  const std::uint64_t kicks_stalled = b.watchdog.kicks();
+  idle(0.5);
+  CHECK(b.watchdog.kicks() == kicks_stalled);
+  // Blocks come back (the sampler recovered): running again, kicks resume. (The
+  // synthetic blocks' times are behind the idle clock, so give it time to pass.)
+  b.run_for(dev, 4.0F);
+  CHECK_FALSE(dev.sampler_stalled());
+  CHECK(heartbeat_state() == proto::can::NodeState::running);
+  CHECK(b.watchdog.kicks() > kicks_stalled);
+}

@@ -112,6 +112,9 @@ void Device::apply_config(const proto::DeviceConfig& cfg, bool restart_sampler) 
   if (restart_sampler || rate_changed) {
     sampler_ok_ = board_.emg.start(cfg.sample_rate_hz);
     block_seen_ = false;  // a restarted sampler may restart its sequence
+    sampler_since_us_ = board_.clock.now_us();
+    stall_restarts_ = 0;
+    sampler_stalled_ = false;
   }
 }
 
@@ -148,9 +151,23 @@ void Device::poll() {
   }
   calibrator_.on_tick(board_.clock.now_us());
   if (calibrator_.take_changed()) config_dirty_ = true;
+  check_sampler(board_.clock.now_us());
   send_heartbeat(board_.clock.now_us());
   update_led();
-  board_.watchdog.kick();
+  // A stalled sampler is a fault the main loop cannot fix: the watchdog resets the chip.
+  if (!sampler_stalled_) board_.watchdog.kick();
+}
+
+void Device::check_sampler(std::uint64_t now_us) {
+  if (!sampler_ok_ || sampler_stalled_ || now_us < sampler_since_us_ + kSamplerStallUs) return;
+  if (stall_restarts_ == 0) {
+    ++stall_restarts_;
+    sampler_ok_ = board_.emg.start(config_.sample_rate_hz);
+    block_seen_ = false;
+    sampler_since_us_ = now_us;
+    return;
+  }
+  sampler_stalled_ = true;
 }
 
 void Device::process_block(const hal::SampleBlock& block, std::uint64_t now_us) {
@@ -171,6 +188,9 @@ void Device::process_block(const hal::SampleBlock& block, std::uint64_t now_us) 
   }
   block_seen_ = true;
   next_block_ = block.sequence + 1;
+  sampler_since_us_ = now_us;
+  stall_restarts_ = 0;
+  sampler_stalled_ = false;
 
   const std::uint32_t rate = config_.sample_rate_hz;
   const std::uint64_t end_us = block.first_sample_us + static_cast<std::uint64_t>(block.frames) * 1000000U / rate;
@@ -467,9 +487,9 @@ void Device::send_heartbeat(std::uint64_t now_us) {
   if (board_.can == nullptr || now_us < next_heartbeat_us_) return;
   next_heartbeat_us_ = now_us + kHeartbeatPeriodUs;
   proto::can::Heartbeat hb{};
-  hb.state = !sampler_ok_            ? proto::can::NodeState::fault
-             : calibrator_.running() ? proto::can::NodeState::calibrating
-                                     : proto::can::NodeState::running;
+  hb.state = !sampler_ok_ || sampler_stalled_ ? proto::can::NodeState::fault
+             : calibrator_.running()          ? proto::can::NodeState::calibrating
+                                              : proto::can::NodeState::running;
   hb.status = status_bits();
   hb.uptime_ms = static_cast<std::uint32_t>((now_us - boot_us_) / 1000U);
   if (!board_.can->send(proto::can::encode_heartbeat(hb, config_.can_node_id))) ++stats_.tx_dropped;
@@ -477,7 +497,7 @@ void Device::send_heartbeat(std::uint64_t now_us) {
 
 void Device::update_led() {
   hal::LedPattern p = hal::LedPattern::running;
-  if (!sampler_ok_) {
+  if (!sampler_ok_ || sampler_stalled_) {
     p = hal::LedPattern::fault;
   } else if (calibrator_.running()) {
     p = hal::LedPattern::calibrating;

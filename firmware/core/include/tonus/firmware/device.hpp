@@ -27,6 +27,10 @@
 namespace tonus::fw {
 
 inline constexpr std::uint32_t kHeartbeatPeriodUs = 1000000;
+// A sampler that delivers no block for this long has stalled: it is restarted
+// once; if that does not bring blocks back the band reports a fault and stops
+// kicking the watchdog, so the chip resets.
+inline constexpr std::uint64_t kSamplerStallUs = 200000;
 
 // Which transport a command came in on; its response goes back the same way.
 enum class Link : std::uint8_t { hid, can };
@@ -67,11 +71,14 @@ class Device {
   [[nodiscard]] LoadResult boot_load_result() const { return load_result_; }
   [[nodiscard]] std::span<const float, kChannels> envelopes() const { return envelopes_; }
   [[nodiscard]] std::uint32_t stale_blocks() const { return stale_blocks_; }
+  // The sampler delivered nothing for kSamplerStallUs even after a restart.
+  [[nodiscard]] bool sampler_stalled() const { return sampler_stalled_; }
   [[nodiscard]] const Calibrator& calibrator() const { return calibrator_; }
 
  private:
   void apply_config(const proto::DeviceConfig& cfg, bool restart_sampler);
   void process_block(const hal::SampleBlock& block, std::uint64_t now_us);
+  void check_sampler(std::uint64_t now_us);
   void process_frame(const std::int16_t* frame, std::uint64_t t_us);
   void emit_report(std::uint64_t t_us);
   void poll_hid();
@@ -112,6 +119,9 @@ class Device {
   bool config_dirty_ = false;
   bool watchdog_reset_ = false;
   bool sampler_ok_ = false;
+  bool sampler_stalled_ = false;        // no blocks even after a restart
+  std::uint64_t sampler_since_us_ = 0;  // the last block, or the last (re)start of the sampler
+  std::uint8_t stall_restarts_ = 0;     // restarts since the last block
   LoadResult load_result_ = LoadResult::empty;
   std::uint64_t next_heartbeat_us_ = 0;
   proto::can::Reassembler can_requests_{proto::can::Function::request, 1};
