@@ -77,7 +77,8 @@ Error encode_stream(const StreamMessage& msg, std::uint8_t node, bool with_envel
   ByteWriter ws(status.data);
   ws.u16(msg.sequence);
   ws.u32(msg.device_time_us);
-  ws.u16(msg.status);
+  ws.u16(static_cast<std::uint16_t>((msg.status & (0xFFFFU ^ kStatusEnvelopesFollow)) |
+                                    (env_frames != 0 ? kStatusEnvelopesFollow : 0U)));
   status.dlc = 8;
   out[n++] = status;
 
@@ -131,6 +132,8 @@ Error StreamAssembler::push(const CanFrame& frame, bool& complete) {
       pending_.sequence = r.u16();
       pending_.device_time_us = r.u32();
       pending_.status = r.u16();
+      envelopes_expected_ = (pending_.status & kStatusEnvelopesFollow) != 0;
+      pending_.status = static_cast<std::uint16_t>(pending_.status & (0xFFFFU ^ kStatusEnvelopesFollow));
       in_cycle_ = true;
       return Error::ok;
     }
@@ -218,6 +221,10 @@ Error StreamAssembler::push(const CanFrame& frame, bool& complete) {
             return Error::out_of_order;
           }
         }
+      } else if (envelopes_expected_) {
+        // Announced but none arrived: lost, not a cycle sent without them.
+        ++incomplete_cycles_;
+        return Error::out_of_order;
       } else {
         pending_.envelopes = msg_.envelopes;  // hold the last envelopes
       }

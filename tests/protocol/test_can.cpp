@@ -104,6 +104,33 @@ TEST_CASE("losing any frame of a cycle loses that cycle and nothing else") {
   }
 }
 
+TEST_CASE("losing every envelope frame of a cycle loses the cycle; it does not pass for one sent without them") {
+  for (const std::uint8_t channels : {std::uint8_t{4}, std::uint8_t{8}, std::uint8_t{16}}) {
+    CAPTURE(int{channels});
+    const StreamMessage m = make_message(4, channels, 20);
+    auto lossy = frames_of(m, 3, true);
+    const auto before = lossy.size();
+    std::erase_if(lossy, [](const CanFrame& f) {
+      Function fn{};
+      std::uint8_t node = 0;
+      return split_id(f.id, fn, node) && fn >= Function::envelope0 && fn <= Function::envelope3;
+    });
+    REQUIRE(lossy.size() < before);
+    StreamAssembler a(3);
+    CHECK(feed(a, lossy) == 0);  // before the fix: delivered, with the previous envelopes
+    CHECK(a.incomplete_cycles() == 1);
+    // A cycle really sent without envelopes is delivered, and the status comes through without the binding's bit.
+    StreamAssembler b(3);
+    CHECK(feed(b, frames_of(m, 3, false)) == 1);
+    CHECK(b.message().status == m.status);
+    CHECK_FALSE(b.envelopes_fresh());
+    StreamAssembler c(3);
+    CHECK(feed(c, frames_of(m, 3, true)) == 1);
+    CHECK(c.message() == m);
+    CHECK(c.envelopes_fresh());
+  }
+}
+
 TEST_CASE("frames of two cycles never merge when closing and opening frames are lost") {
   const StreamMessage m1 = make_message(4, 8, 20);
   const StreamMessage m2 = make_message(4, 8, 21);

@@ -46,6 +46,7 @@ std::map<std::uint32_t, std::map<std::string, double>> expected_signals(const St
   st["WatchdogReset"] = bit(status_bit::watchdog_reset);
   st["ConfigDirty"] = bit(status_bit::config_dirty);
   st["BlockLost"] = bit(status_bit::block_lost);
+  st["EnvelopesFollow"] = 1.0;  // the frame is encoded with envelopes (below)
   for (std::size_t g = 0; g < kMaxGroups; ++g) {
     const auto f = g < 4 ? can::Function::levels0 : can::Function::levels1;
     e[can::make_id(f, kNode)]["Level" + std::to_string(g)] = m.levels[g] / 65535.0;

@@ -51,6 +51,13 @@ struct CanFrame {
 namespace can {
 
 inline constexpr std::uint8_t kMaxNodeId = 31;
+
+// The CAN binding's own bit in the STATUS frame's status word: this cycle
+// carries envelope frames. Without it a cycle whose envelope frames were all
+// lost would look like one sent without them. Device status bits never use
+// it (stream.hpp); the assembler strips it, and a decoder that ignores it
+// (an older host) reads the cycle as before.
+inline constexpr std::uint16_t kStatusEnvelopesFollow = 0x8000;
 inline constexpr std::uint32_t kNodeMask = 0x1F;
 
 enum class Function : std::uint16_t {
@@ -110,6 +117,7 @@ class StreamAssembler {
   StreamMessage pending_{};
   StreamMessage msg_{};
   bool envelopes_fresh_ = false;
+  bool envelopes_expected_ = false;  // the STATUS frame said envelope frames follow
   std::uint32_t incomplete_cycles_ = 0;
   std::uint32_t stray_frames_ = 0;
 };

@@ -25,6 +25,7 @@ inline constexpr std::uint16_t watchdog_reset = 1U << 2U;  // last restart was b
 inline constexpr std::uint16_t config_dirty = 1U << 3U;    // RAM config differs from NVM
 inline constexpr std::uint16_t block_lost = 1U << 4U;      // a sample block was lost since the last report
 inline constexpr std::uint16_t known_mask = 0x001F;
+// Bit 15 is the CAN binding's (can::kStatusEnvelopesFollow), never a device status.
 }  // namespace status_bit
 
 inline constexpr std::size_t kStreamHeaderSize = 18;
