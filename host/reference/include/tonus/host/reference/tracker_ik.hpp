@@ -9,8 +9,8 @@
 //      hands; the head's tilt shared out down the neck, chest, spine and
 //      pelvis; the pelvis placed where that chain puts the head exactly on its
 //      tracker, so crouching and leaning come out of the head's height.
-//      6 points: the pelvis from the waist tracker and the spine bent to
-//      reach the head (FABRIK on three links).
+//      6 points: the pelvis from the waist tracker, the spine and chest
+//      turned as one piece so the neck reaches the head (closed form).
 //   3. Arms: the clavicle raised toward a high or far hand; two-bone arms that
 //      put the wrist on the tracker, the elbow on the side away from where the
 //      hand points (least wrist bend), or toward an elbow tracker.
