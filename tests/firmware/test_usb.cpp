@@ -3,6 +3,8 @@
 // bad requests, and the firmware core streaming through it.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+
 #include <string>
 #include <vector>
 
@@ -261,4 +263,35 @@ TEST_CASE("the firmware core streams and answers through the USB stack") {
     }
   }
   CHECK(answered);
+}
+
+TEST_CASE("GET_REPORT over EP0 returns the last input report of that id, not zeros") {
+  FakeDcd dcd;
+  DeviceCore core(dcd, 1);
+  enumerate(core, dcd);
+  proto::hid::Report stream{};
+  stream[0] = proto::hid::kReportIdStream;
+  for (std::size_t k = 1; k < stream.size(); ++k) stream[k] = static_cast<std::uint8_t>(k * 3U);
+  REQUIRE(core.send_input(stream));
+  dcd.sent.clear();
+  core.on_setup(setup(0xA1, 1, 0x0101, 0, 64));  // GET_REPORT, input, id 1
+  REQUIRE(dcd.sent.size() == 64);
+  CHECK(std::equal(stream.begin(), stream.end(), dcd.sent.begin()));  // before: id + zeros
+  // A response report is kept apart from the stream's.
+  proto::hid::Report response{};
+  response[0] = proto::hid::kReportIdResponse;
+  response[5] = 0x5A;
+  REQUIRE(core.send_input(response));
+  dcd.sent.clear();
+  core.on_setup(setup(0xA1, 1, 0x0103, 0, 64));
+  REQUIRE(dcd.sent.size() == 64);
+  CHECK(dcd.sent[5] == 0x5A);
+  dcd.sent.clear();
+  core.on_setup(setup(0xA1, 1, 0x0101, 0, 64));
+  CHECK(std::equal(stream.begin(), stream.end(), dcd.sent.begin()));
+  // Feature reports and unknown ids do not exist: stalled.
+  core.on_setup(setup(0xA1, 1, 0x0301, 0, 64));
+  CHECK(dcd.last == FakeDcd::Stage::stall);
+  core.on_setup(setup(0xA1, 1, 0x0107, 0, 64));
+  CHECK(dcd.last == FakeDcd::Stage::stall);
 }

@@ -1,5 +1,7 @@
 #include "tonus/usb/device_core.hpp"
 
+#include <algorithm>
+
 namespace tonus::usb {
 
 namespace {
@@ -14,7 +16,7 @@ constexpr std::uint8_t kGetStatus = 0, kClearFeature = 1, kSetFeature = 3, kSetA
                        kGetConfiguration = 8, kSetConfiguration = 9, kGetInterface = 10, kSetInterface = 11;
 // HID class requests (HID 1.11 section 7.2)
 constexpr std::uint8_t kGetReport = 1, kGetIdle = 2, kGetProtocol = 3, kSetReport = 9, kSetIdle = 10, kSetProtocol = 11;
-constexpr std::uint8_t kReportTypeOutput = 2;
+constexpr std::uint8_t kReportTypeInput = 1, kReportTypeOutput = 2;
 
 std::uint16_t le16(std::uint8_t lo, std::uint8_t hi) { return static_cast<std::uint16_t>(lo | (hi << 8U)); }
 
@@ -149,9 +151,18 @@ void DeviceCore::class_request(const SetupPacket& s) {
       reply(std::span<const std::uint8_t>(ep0_buffer_).first(1), s.length);
       return;
     case kGetReport: {
-      // Input reports travel on EP1; polled over EP0 they read as empty (id + zeros).
+      // The last input report of that id (a host polling the control pipe);
+      // id + zeros before the first. Other report types do not exist here.
+      const auto id = static_cast<std::uint8_t>(s.value & 0xFFU);
+      const int kind = id == proto::hid::kReportIdStream ? 0 : (id == proto::hid::kReportIdResponse ? 1 : -1);
+      if ((s.value >> 8U) != kReportTypeInput || kind < 0) break;
+      const LastInput& last = last_input_[static_cast<std::size_t>(kind)];
       ep0_buffer_.fill(0);
-      ep0_buffer_[0] = static_cast<std::uint8_t>(s.value & 0xFFU);
+      ep0_buffer_[0] = id;
+      if (last.any.load()) {
+        const proto::hid::Report& r = last.slot[last.published.load()];
+        std::copy(r.begin(), r.end(), ep0_buffer_.begin());
+      }
       reply(std::span<const std::uint8_t>(ep0_buffer_).first(proto::hid::kReportSize), s.length);
       return;
     }
@@ -206,7 +217,16 @@ bool DeviceCore::send_input(const proto::hid::Report& report) {
   // The DCD refuses while the previous packet is still in flight (the host
   // polls EP1 every 1 ms); it copies an accepted packet before returning.
   static_assert(proto::hid::kReportSize == kHidPacket);
-  return dcd_.hid_send(report);
+  if (!dcd_.hid_send(report)) return false;
+  const int kind = report[0] == proto::hid::kReportIdStream ? 0 : (report[0] == proto::hid::kReportIdResponse ? 1 : -1);
+  if (kind >= 0) {
+    LastInput& last = last_input_[static_cast<std::size_t>(kind)];
+    const auto next = static_cast<std::uint8_t>(last.published.load() ^ 1U);
+    last.slot[next] = report;
+    last.published.store(next);
+    last.any.store(true);
+  }
+  return true;
 }
 
 }  // namespace tonus::usb

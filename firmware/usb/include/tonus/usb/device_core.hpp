@@ -59,6 +59,16 @@ class DeviceCore final : public hal::UsbHid {
   std::array<std::uint8_t, 64> ep0_buffer_{};
   bool set_report_pending_ = false;
 
+  // The last input report of each kind (stream, response) for GET_REPORT over
+  // EP0: written by the main loop into the slot the interrupt is not told of,
+  // then published, so the interrupt always copies a whole report.
+  struct LastInput {
+    std::array<proto::hid::Report, 2> slot{};
+    std::atomic<std::uint8_t> published{0};
+    std::atomic<bool> any{false};
+  };
+  std::array<LastInput, 2> last_input_{};  // [stream, response]
+
   static constexpr std::size_t kOutQueue = 8;
   struct OutReport {
     proto::hid::Report bytes{};
