@@ -33,10 +33,14 @@ endfunction()
 # Link-time heap poison: every allocation entry point is redirected with
 # --wrap to a symbol that is never defined, so any object file of ours that
 # references malloc/new/exceptions fails to link.
+# operator new and new[] are mangled with size_t's type: unsigned long (m) on
+# x86-64, unsigned int (j) on the Cortex-M4; both are listed.
 set(TONUS_HEAP_SYMBOLS
   malloc calloc realloc free aligned_alloc posix_memalign memalign
   _Znwm _Znam _ZnwmRKSt9nothrow_t _ZnamRKSt9nothrow_t
   _ZnwmSt11align_val_t _ZnamSt11align_val_t
+  _Znwj _Znaj _ZnwjRKSt9nothrow_t _ZnajRKSt9nothrow_t
+  _ZnwjSt11align_val_t _ZnajSt11align_val_t
   __cxa_allocate_exception __cxa_throw)
 function(tonus_poison_heap target)
   foreach(sym IN LISTS TONUS_HEAP_SYMBOLS)
