@@ -91,12 +91,11 @@ Vec3 joint_of(const Work& w, const IkModel& m, Bone b) {
 }
 
 // Where the neck joint goes so the neck reaches the head joint, the spine
-// and chest turned as one piece about the spine joint `base`: on the circle
-// where the sphere the lower trunk's end can reach (about the base) meets the
-// sphere of the neck's length (about the head), the point nearest the guess.
-// Closed form, so a smooth function of its inputs, and the neck takes the
-// head's quick moves as a real neck does. False (the trunk pointed straight
-// at the head) when no such point exists.
+// and chest turned as one piece about the spine joint `base`: the middle
+// joint of the two links trunk (base to the guessed neck joint) and neck,
+// on the side of the guess. Closed form, so a smooth function of its inputs,
+// and the neck takes the head's quick moves as a real neck does. False (the
+// trunk pointed straight at the head) when the head is out of reach.
 bool reach_head(const Vec3& base, const Vec3& neck_guess, double neck_m, const Vec3& head, Vec3& neck_joint) {
   const Vec3 to_head = head - base;
   const double dist = to_head.norm();
@@ -106,14 +105,11 @@ bool reach_head(const Vec3& base, const Vec3& neck_guess, double neck_m, const V
     return false;
   }
   const Vec3 u = to_head / dist;
-  const bool reachable = dist <= trunk_m + neck_m && dist >= std::abs(trunk_m - neck_m);
-  const double along =
-      std::clamp((trunk_m * trunk_m - neck_m * neck_m + dist * dist) / (2.0 * dist), -trunk_m, trunk_m);
-  const double across = std::sqrt(std::max(0.0, trunk_m * trunk_m - along * along));
-  Vec3 side = (neck_guess - base) - (neck_guess - base).dot(u) * u;
-  side = side.norm() > 1e-9 ? Vec3(side.normalized()) : Vec3(u.unitOrthogonal());
-  neck_joint = base + along * u + across * side;
-  return reachable;
+  const double shortest = std::abs(trunk_m - neck_m), longest = trunk_m + neck_m;
+  neck_joint = detail::place_middle_joint(base, u, std::clamp(dist, shortest, longest), trunk_m, neck_m,
+                                          neck_guess - base, u.unitOrthogonal())
+                   .pos;
+  return dist <= longest && dist >= shortest;
 }
 
 }  // namespace

@@ -19,11 +19,24 @@ bool across(const sim::Vec3& v, const sim::Vec3& d, sim::Vec3& out) {
 
 }  // namespace
 
+MiddleJoint place_middle_joint(const sim::Vec3& root, const sim::Vec3& dir, double dist, double a, double b,
+                               const sim::Vec3& pole, const sim::Vec3& fallback_pole) {
+  MiddleJoint m;
+  if (!across(pole, dir, m.side) && !across(fallback_pole, dir, m.side)) {
+    const sim::Vec3 any = std::abs(dir.x()) < 0.9 ? sim::Vec3::UnitX() : sim::Vec3::UnitY();
+    across(any, dir, m.side);
+  }
+  const double cos_a = std::clamp((a * a + dist * dist - b * b) / (2.0 * a * dist), -1.0, 1.0);
+  const double sin_a = std::sqrt(std::max(0.0, 1.0 - cos_a * cos_a));
+  m.pos = root + a * (cos_a * dir + sin_a * m.side);
+  return m;
+}
+
 TwoBoneSolution solve_two_bone(const TwoBoneLimb& limb, const sim::Vec3& root, const sim::Vec3& target,
                                const sim::Vec3& pole, const sim::Vec3& fallback_pole) {
   TwoBoneSolution s;
   const double a = limb.upper_m, b = limb.lower_m;
-  sim::Vec3 d = target - root;
+  const sim::Vec3 d = target - root;
   double dist = d.norm();
   sim::Vec3 dir;
   if (dist < 1e-9) {
@@ -32,24 +45,16 @@ TwoBoneSolution solve_two_bone(const TwoBoneLimb& limb, const sim::Vec3& root, c
     dir = d / dist;
   }
   const double shortest = std::abs(a - b) + 1e-9, longest = a + b;
-  s.reached = dist >= shortest && dist <= longest;
   if (limb.soft_m > 0.0 && dist > longest - limb.soft_m) {
     dist = longest - limb.soft_m * std::exp(-(dist - (longest - limb.soft_m)) / limb.soft_m);
   }
   dist = std::clamp(dist, shortest, longest);
 
-  sim::Vec3 p;
-  if (!across(pole, dir, p) && !across(fallback_pole, dir, p)) {
-    sim::Vec3 any = std::abs(dir.x()) < 0.9 ? sim::Vec3::UnitX() : sim::Vec3::UnitY();
-    across(any, dir, p);
-  }
-  const double cos_a = std::clamp((a * a + dist * dist - b * b) / (2.0 * a * dist), -1.0, 1.0);
-  const double sin_a = std::sqrt(std::max(0.0, 1.0 - cos_a * cos_a));
-  const sim::Vec3 middle = root + a * (cos_a * dir + sin_a * p);
+  const MiddleJoint middle = place_middle_joint(root, dir, dist, a, b, pole, fallback_pole);
   const sim::Vec3 end = root + dist * dir;
-  const sim::Vec3 u = (middle - root) / a;
-  const sim::Vec3 f = (end - middle) / b;
-  const sim::Vec3 n = p.cross(dir);  // the hinge axis in the world for a positive bend
+  const sim::Vec3 u = (middle.pos - root) / a;
+  const sim::Vec3 f = (end - middle.pos) / b;
+  const sim::Vec3 n = middle.side.cross(dir);  // the hinge axis in the world for a positive bend
   if (!frame_match(limb.upper_dir, limb.hinge, u, n, s.upper)) {
     s.upper = sim::Quat::FromTwoVectors(limb.upper_dir, u);
   }

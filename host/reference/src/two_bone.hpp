@@ -24,8 +24,19 @@ struct TwoBoneLimb {
 struct TwoBoneSolution {
   sim::Quat upper = sim::Quat::Identity();  // the upper bone's world rotation
   double hinge_rad = 0.0;                   // the middle joint's angle
-  bool reached = true;                      // false: the target was out of reach (the limb points at it)
 };
+
+// The middle joint of two links of lengths a and b from `root`, whose end
+// lies `dist` along the unit `dir` (dist within [|a - b|, a + b]): on the
+// circle where the spheres about the root and the end meet, on the side of
+// `pole` across the line (`fallback_pole` when that part vanishes). `side`
+// is that unit direction across the line.
+struct MiddleJoint {
+  sim::Vec3 pos = sim::Vec3::Zero();
+  sim::Vec3 side = sim::Vec3::Zero();
+};
+MiddleJoint place_middle_joint(const sim::Vec3& root, const sim::Vec3& dir, double dist, double a, double b,
+                               const sim::Vec3& pole, const sim::Vec3& fallback_pole);
 
 // Puts the end joint on `target` from the upper joint at `root`. The middle
 // joint goes toward `pole` (the part of it across the root-target line);
