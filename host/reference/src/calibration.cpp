@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include "body_frames.hpp"
+#include "tracker_input.hpp"
 
 namespace tonus::reference {
 namespace {
@@ -15,11 +16,6 @@ using sim::Vec3;
 constexpr double kHandLengthPerStature = 0.108;  // wrist to fingertip (Winter), as sim's humanoid
 constexpr double kMinArmScale = 0.7;
 constexpr double kMaxArmScale = 1.4;
-
-bool usable(const TrackerPose& p) {
-  return p.valid && p.pos_m.allFinite() && p.rot.coeffs().allFinite() && std::abs(p.rot.norm() - 1.0) < 0.1 &&
-         p.pos_m.norm() < 1e3;
-}
 
 std::size_t bi(Bone b) { return sim::index(b); }
 
@@ -44,7 +40,7 @@ sim::HumanoidSpec calibrated_spec(const BodyCalibration& body, double mass_kg) {
 CalibrationResult calibrate(const TrackerFrame& standing, const CalibrationOptions& opt) {
   CalibrationResult r;
   for (const Tracker t : {Tracker::head, Tracker::left_hand, Tracker::right_hand}) {
-    if (!usable(standing[t])) {
+    if (!detail::usable_sample(standing[t])) {
       r.error =
           "calibration needs the " + std::string(tracker_name(t)) + " tracker: its sample is missing or not finite";
       return r;
@@ -111,7 +107,7 @@ CalibrationResult calibrate(const TrackerFrame& standing, const CalibrationOptio
   }
   detail::place_bones(o, root, f);
   for (std::size_t t = 0; t < kTrackerCount; ++t) {
-    if (!usable(standing.pose[t])) continue;
+    if (!detail::usable_sample(standing.pose[t])) continue;
     const std::size_t b = bi(tracked_bone(static_cast<Tracker>(t)));
     const TrackerPose bone{f.pos[b], f.rot[b], true};
     TrackerPose sample = standing.pose[t];
