@@ -48,6 +48,15 @@ double smooth_max(double a, double b, double soft) {
 // The share of the way a first-order filter of time constant tau moves in dt.
 double smoothing(double dt, double tau) { return tau > 0.0 ? dt / (tau + dt) : 1.0; }
 
+// A pole direction smoothed toward `raw` and kept unit, so a weak cue (two
+// that disagree, or both small) barely turns it and it never shrinks through
+// zero (a flip). Starts (or restarts, if unset) at `start`.
+void smooth_pole(Vec3& pole, const Vec3& raw, const Vec3& start, bool restart, double share) {
+  if (restart || pole.norm() < 0.5) pole = start;
+  const Vec3 moved = pole + share * (raw - pole);
+  if (moved.norm() > 1e-6) pole = moved.normalized();
+}
+
 double yaw_of(const Vec3& forward, double fallback) {
   const Vec3 f = horizontal(forward);
   return f.norm() > 1e-6 ? std::atan2(f.y(), f.x()) : fallback;
@@ -297,7 +306,7 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
   detail::place_bones(m.offset, pelvis_now, w.f);  // trunk joints (limbs are redone below)
 
   // Plausibility of the hands against the body.
-  const Quat body_yaw = yaw_quat(yaw);
+  const Quat& body_yaw = heading;
   {
     const Vec3 l = body_yaw.conjugate() * (lh.target.pos_m - w.f.pos[bi(Bone::Chest)]);
     const Vec3 r = body_yaw.conjugate() * (rh.target.pos_m - w.f.pos[bi(Bone::Chest)]);
@@ -369,19 +378,15 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     // little about the elbow, and must not flip it.
     const Vec3 hand_dir = target.rot * m.rest_dir[bi(hand)];
     const Vec3 anatomic = chest * Vec3(-0.4, 0.3 * rest_arm.y(), -1.0);
-    Vec3 along = target.pos_m - shoulder;
-    along = along.norm() > 1e-9 ? Vec3(along.normalized()) : Vec3(chest * -Vec3::UnitZ());
+    const Vec3 line = target.pos_m - shoulder;
+    const Vec3 along = line.norm() > 1e-9 ? Vec3(line.normalized()) : Vec3(chest * -Vec3::UnitZ());
     const auto across_line = [&](const Vec3& v) { return Vec3(v - v.dot(along) * along); };
     const Vec3 hand_part = across_line(-hand_dir);
     const Vec3 raw_pole =
         chest.conjugate() * (hand_part.norm() * hand_part + o.default_pole_weight * across_line(anatomic.normalized()));
     // Smoothed in the chest's frame: a hand's quick turns are the wrist's.
-    // The smoothed pole is kept unit, so a weak cue (the two disagreeing, or
-    // both small) barely turns it and it never shrinks through zero (a flip).
-    const Vec3 anatomic_local = chest.conjugate() * anatomic.normalized();
-    if (!st.started || st.elbow_pole[s].norm() < 0.5) st.elbow_pole[s] = anatomic_local;
-    const Vec3 moved = st.elbow_pole[s] + smoothing(dt, o.elbow_smoothing_s) * (raw_pole - st.elbow_pole[s]);
-    if (moved.norm() > 1e-6) st.elbow_pole[s] = moved.normalized();
+    smooth_pole(st.elbow_pole[s], raw_pole, chest.conjugate() * anatomic.normalized(), !st.started,
+                smoothing(dt, o.elbow_smoothing_s));
     Vec3 pole = chest * st.elbow_pole[s];
     IkState::Track& et = st.track[index(kElbow[s])];
     if (m.calibration.offset[index(kElbow[s])].valid && et.seen) {
@@ -394,7 +399,6 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     detail::TwoBoneSolution sol = detail::solve_two_bone(limb, shoulder, target.pos_m, pole, anatomic);
     // An elbow the upper arm cannot twist to is turned about the shoulder-wrist
     // line until it can (the twist follows that turn almost one to one).
-    const Vec3 line = target.pos_m - shoulder;
     const sim::JointLimit& lim = m.limit[bi(upper)];
     const auto local_of = [&](const detail::TwoBoneSolution& so) {
       return Quat((w.f.rot[bi(clav)].conjugate() * so.upper).normalized());
@@ -449,8 +453,8 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
   // 5. Legs.
   if (!st.started) st.pelvis_velocity = Vec3::Zero();
   if (st.started && dt > 0.0) {
-    const double alpha = dt / (o.velocity_time_constant_s + dt);
-    st.pelvis_velocity += alpha * ((pelvis_now - st.last_pelvis) / dt - st.pelvis_velocity);
+    st.pelvis_velocity +=
+        smoothing(dt, o.velocity_time_constant_s) * ((pelvis_now - st.last_pelvis) / dt - st.pelvis_velocity);
   }
   st.last_pelvis = pelvis_now;
   const double pelvis_yaw = yaw_of(w.f.rot[0] * Vec3::UnitX(), yaw);
@@ -487,10 +491,8 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     const Vec3 pelvis_fwd = horizontal(w.f.rot[0] * Vec3::UnitX());
     const Vec3 raw_knee = (foot_fwd.norm() > 1e-6 ? Vec3(foot_fwd.normalized()) : Vec3::Zero()) +
                           kPelvisKneeWeight * (pelvis_fwd.norm() > 1e-6 ? Vec3(pelvis_fwd.normalized()) : Vec3::Zero());
-    // Smoothed and kept unit, as the elbows' (a foot's quick turns are the ankle's).
-    if (!st.started || st.knee_pole[s].norm() < 0.5) st.knee_pole[s] = body_yaw * Vec3::UnitX();
-    const Vec3 knee_moved = st.knee_pole[s] + smoothing(dt, o.knee_smoothing_s) * (raw_knee - st.knee_pole[s]);
-    if (knee_moved.norm() > 1e-6) st.knee_pole[s] = knee_moved.normalized();
+    // Smoothed as the elbows' (a foot's quick turns are the ankle's).
+    smooth_pole(st.knee_pole[s], raw_knee, body_yaw * Vec3::UnitX(), !st.started, smoothing(dt, o.knee_smoothing_s));
     Vec3 pole = st.knee_pole[s];
     IkState::Track& kt = st.track[index(kKnee[s])];
     if (m.calibration.offset[index(kKnee[s])].valid && kt.seen) {
