@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "stats.hpp"
 #include "tonus/host/balance/convert.hpp"
 #include "tonus/host/balance/skeleton_map.hpp"
 #include "tonus/host/motion/bvh.hpp"
@@ -72,25 +73,24 @@ TrackerFrame trackers_of(const sim::Data& data, const std::array<TrackerPose, re
   return f;
 }
 
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  const auto k = static_cast<std::size_t>(std::clamp(p, 0.0, 1.0) * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
-
-// Mean joint jerk (third difference over dt^3) of a joint track.
-double jitter(const std::vector<std::array<Vec3, sim::kBoneCount>>& j, double dt) {
-  if (j.size() < 4) return 0.0;
-  double sum = 0.0;
-  std::size_t n = 0;
+// Per joint, the sum over the track of the jerk's size times dt^3 (the
+// third difference of its position).
+JointJerk jerk_sums(const std::vector<std::array<Vec3, sim::kBoneCount>>& j) {
+  JointJerk sums{};
   for (std::size_t f = 3; f < j.size(); ++f) {
     for (std::size_t b = 0; b < sim::kBoneCount; ++b) {
-      sum += (j[f][b] - 3.0 * j[f - 1][b] + 3.0 * j[f - 2][b] - j[f - 3][b]).norm();
-      ++n;
+      sums[b] += (j[f][b] - 3.0 * j[f - 1][b] + 3.0 * j[f - 2][b] - j[f - 3][b]).norm();
     }
   }
-  return sum / static_cast<double>(n) / (dt * dt * dt);
+  return sums;
+}
+
+// Mean joint jerk (m/s^3) of a track of `frames` frames from its sums.
+double jitter(const JointJerk& sums, std::size_t frames, double dt) {
+  if (frames < 4) return 0.0;
+  double total = 0.0;
+  for (const double s : sums) total += s;
+  return total / static_cast<double>((frames - 3) * sim::kBoneCount) / (dt * dt * dt);
 }
 
 IkRun run_condition(const std::string& condition, const IkSetup& truth, const reference::IkModel& ik,
@@ -205,17 +205,12 @@ IkRun run_condition(const std::string& condition, const IkSetup& truth, const re
   run.head_error_mean_mm = mean(head_err);
   run.head_error_max_mm = max_of(head_err);
   run.hand_truth_mean_mm = mean(hand_truth);
-  run.jitter_mps3 = jitter(solved, truth.dt_s);
+  const JointJerk solved_jerk = jerk_sums(solved);
+  run.jitter_mps3 = jitter(solved_jerk, n, truth.dt_s);
   for (std::size_t b = 0; b < sim::kBoneCount; ++b) {
-    double a = 0.0, c = 0.0;
-    for (std::size_t f = 3; f < n; ++f) {
-      a += (solved[f][b] - 3.0 * solved[f - 1][b] + 3.0 * solved[f - 2][b] - solved[f - 3][b]).norm();
-      c += (truth.joints[f][b] - 3.0 * truth.joints[f - 1][b] + 3.0 * truth.joints[f - 2][b] - truth.joints[f - 3][b])
-               .norm();
-    }
-    run.joint_jitter_ratio[b] = c > 0.0 ? a / c : 0.0;
+    run.joint_jitter_ratio[b] = truth.jerk[b] > 0.0 ? solved_jerk[b] / truth.jerk[b] : 0.0;
   }
-  const double source = jitter(truth.joints, truth.dt_s);
+  const double source = jitter(truth.jerk, n, truth.dt_s);
   run.jitter_ratio = source > 0.0 ? run.jitter_mps3 / source : 0.0;
   double verr = 0.0;
   std::size_t nv = 0;
@@ -339,7 +334,8 @@ IkSetup prepare_ik_eval(const IkEvalOptions& opt, IkEvalResult& r) {
     }
     truth.solved = std::move(solved_model.model);
     truth.ik = std::move(ik.model);
-    r.source_jitter_mps3 = jitter(truth.joints, truth.dt_s);
+    truth.jerk = jerk_sums(truth.joints);
+    r.source_jitter_mps3 = jitter(truth.jerk, truth.joints.size(), truth.dt_s);
   } catch (const std::exception& e) {
     r.error = opt.clip + ": " + e.what();
   }

@@ -69,9 +69,12 @@ struct IkEvalResult {
 
 // What a run needs, made once: the ground truth (its humanoid, its joints
 // and the trackers per frame), and the calibrated humanoid and solver.
+using JointJerk = std::array<double, sim::kBoneCount>;  // per joint, the summed |third difference| (m)
+
 struct IkSetup {
   std::unique_ptr<sim::Model> model;  // the truth's humanoid
   std::vector<std::array<sim::Vec3, sim::kBoneCount>> joints;
+  JointJerk jerk{};  // the truth's, per joint
   std::vector<reference::TrackerFrame> trackers;
   double dt_s = 0.0;
   std::unique_ptr<sim::Model> solved;  // the humanoid the calibration builds

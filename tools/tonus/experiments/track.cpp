@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "scene.hpp"
+#include "stats.hpp"
 #include "tonus/host/reference/clip_reference.hpp"
 
 namespace tonus::experiments {
@@ -77,14 +78,6 @@ void sample(const sim::Model& m, const reference::ClipReference& clip, double t,
     }
   }
   out.has_velocity = false;
-}
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  const auto k = static_cast<std::size_t>(
-      std::clamp(p * static_cast<double>(v.size() - 1), 0.0, static_cast<double>(v.size() - 1)));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
 }
 
 std::string track_variant(const sim::Model& m, const TrackOptions& opt, const reference::ClipReference& clip,
