@@ -399,16 +399,7 @@ BodyStatus BodyRetarget::solve(const BodySample& in, BodyRetargetState& st, std:
 
   // Continuity: each quaternion in the previous output's hemisphere; nothing non-finite out.
   bool ok = true;
-  for (std::size_t i = 0; i < kN; ++i) {
-    const sim::Body& b = body(i);
-    if (b.joint != sim::JointType::ball && b.joint != sim::JointType::free) continue;
-    const std::size_t a = static_cast<std::size_t>(b.qpos_adr) + (b.joint == sim::JointType::free ? 3 : 0);
-    double dot = 0.0;
-    for (std::size_t k = 0; k < 4; ++k) dot += q[a + k] * st.previous[a + k];
-    if (dot < 0.0) {
-      for (std::size_t k = 0; k < 4; ++k) q[a + k] = -q[a + k];
-    }
-  }
+  detail::keep_hemisphere(m, q, st.previous);
   for (std::size_t k = 0; k < nq; ++k) ok = ok && std::isfinite(q[k]);
   if (ok) {
     st.previous = q;

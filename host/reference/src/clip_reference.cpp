@@ -10,6 +10,7 @@
 #include "floor.hpp"
 #include "pose_solver.hpp"
 #include "rig.hpp"
+#include "rotations.hpp"
 #include "tonus/host/balance/contacts.hpp"
 #include "tonus/host/balance/convert.hpp"
 #include "tonus/host/motion/bvh.hpp"
@@ -48,21 +49,10 @@ double clip_leg_m(const balance::HumanMotion& motion) {
   return sum / static_cast<double>(motion.frames.size());
 }
 
-// Quaternions (the root's and every ball joint's) kept in the hemisphere of
-// the previous frame's, so a tracker interpolating them never turns the long way.
+// Quaternions kept in the hemisphere of the previous frame's (the first
+// frame's, of the rest configuration's identities).
 void make_continuous(const sim::Model& m, std::vector<std::array<double, sim::kMaxQpos>>& qpos) {
-  for (std::size_t i = 0; i < sim::kBoneCount; ++i) {
-    const sim::Body& b = m.bodies[i];
-    if (b.joint != sim::JointType::ball && b.joint != sim::JointType::free) continue;
-    const std::size_t a = static_cast<std::size_t>(b.qpos_adr) + (b.joint == sim::JointType::free ? 3 : 0);
-    for (std::size_t f = 0; f < qpos.size(); ++f) {
-      double dot = 0.0;
-      for (std::size_t k = 0; k < 4; ++k) dot += qpos[f][a + k] * (f > 0 ? qpos[f - 1][a + k] : (k == 0 ? 1.0 : 0.0));
-      if (dot < 0.0) {
-        for (std::size_t k = 0; k < 4; ++k) qpos[f][a + k] = -qpos[f][a + k];
-      }
-    }
-  }
+  for (std::size_t f = 0; f < qpos.size(); ++f) detail::keep_hemisphere(m, qpos[f], f > 0 ? qpos[f - 1] : m.qpos0);
 }
 
 void report_clamps(ClipReference& r) {

@@ -41,4 +41,17 @@ double angle_about(const Vec3& axis, const Vec3& v0, const Vec3& v) {
   return std::atan2(axis.dot(a.cross(b)), a.dot(b));
 }
 
+void keep_hemisphere(const sim::Model& m, std::span<double> qpos, std::span<const double> previous) {
+  for (int i = 0; i < m.nbody; ++i) {
+    const sim::Body& b = m.bodies[static_cast<std::size_t>(i)];
+    if (b.joint != sim::JointType::ball && b.joint != sim::JointType::free) continue;
+    const std::size_t a = static_cast<std::size_t>(b.qpos_adr) + (b.joint == sim::JointType::free ? 3 : 0);
+    double dot = 0.0;
+    for (std::size_t k = 0; k < 4; ++k) dot += qpos[a + k] * previous[a + k];
+    if (dot < 0.0) {
+      for (std::size_t k = 0; k < 4; ++k) qpos[a + k] = -qpos[a + k];
+    }
+  }
+}
+
 }  // namespace tonus::reference::detail

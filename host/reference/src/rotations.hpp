@@ -4,6 +4,8 @@
 // (tonus/sim/joint_limits.hpp).
 #pragma once
 
+#include <span>
+
 #include "tonus/sim/model.hpp"
 
 namespace tonus::reference::detail {
@@ -25,5 +27,10 @@ Quat aim(const Quat& from, const Vec3& r, const Vec3& d);
 // The angle about `axis` (unit) that turns v0 closest to v (both projected on
 // the plane normal to the axis); 0 when either projection vanishes.
 double angle_about(const Vec3& axis, const Vec3& v0, const Vec3& v);
+
+// Each quaternion of `qpos` (the free root's rotation, every ball joint's)
+// negated where needed into the hemisphere of the same one in `previous`, so
+// a tracker interpolating them never turns the long way.
+void keep_hemisphere(const sim::Model& m, std::span<double> qpos, std::span<const double> previous);
 
 }  // namespace tonus::reference::detail
