@@ -3,13 +3,14 @@
 #include <cmath>
 #include <numbers>
 
+#include "first_order.hpp"
+
 namespace tonus::reference {
 namespace {
 
 // The share of the way a first-order low-pass at `cutoff_hz` moves in dt.
 double alpha(double cutoff_hz, double dt_s) {
-  const double tau = 1.0 / (2.0 * std::numbers::pi * cutoff_hz);
-  return 1.0 / (1.0 + tau / dt_s);
+  return detail::first_order_share(dt_s, 1.0 / (2.0 * std::numbers::pi * cutoff_hz));
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "body_frames.hpp"
+#include "first_order.hpp"
 #include "foot_steps.hpp"
 #include "rig.hpp"
 #include "rotations.hpp"
@@ -44,9 +45,6 @@ constexpr double kTwistMargin_rad = 0.05;
 double smooth_max(double a, double b, double soft) {
   return 0.5 * (a + b + std::sqrt((a - b) * (a - b) + soft * soft));
 }
-
-// The share of the way a first-order filter of time constant tau moves in dt.
-double smoothing(double dt, double tau) { return tau > 0.0 ? dt / (tau + dt) : 1.0; }
 
 // A pole direction smoothed toward `raw` and kept unit, so a weak cue (two
 // that disagree, or both small) barely turns it and it never shrinks through
@@ -261,7 +259,7 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
   const Quat head_rel = (heading.conjugate() * head.rot).normalized();
   if (!st.started) st.trunk_turn = head_rel;
   if (st.trunk_turn.dot(head_rel) < 0.0) st.trunk_turn.coeffs() = -st.trunk_turn.coeffs();
-  st.trunk_turn = st.trunk_turn.slerp(smoothing(dt, o.trunk_smoothing_s), head_rel).normalized();
+  st.trunk_turn = st.trunk_turn.slerp(detail::first_order_share(dt, o.trunk_smoothing_s), head_rel).normalized();
   const auto share = [&](double s) { return (heading * Quat::Identity().slerp(s, st.trunk_turn)).normalized(); };
   w.f.rot[bi(Bone::Hips)] = share(o.pelvis_share);
   settle_ball(m, w, Bone::Spine, share(o.spine_share));
@@ -386,7 +384,7 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
         chest.conjugate() * (hand_part.norm() * hand_part + o.default_pole_weight * across_line(anatomic.normalized()));
     // Smoothed in the chest's frame: a hand's quick turns are the wrist's.
     smooth_pole(st.elbow_pole[s], raw_pole, chest.conjugate() * anatomic.normalized(), !st.started,
-                smoothing(dt, o.elbow_smoothing_s));
+                detail::first_order_share(dt, o.elbow_smoothing_s));
     Vec3 pole = chest * st.elbow_pole[s];
     IkState::Track& et = st.track[index(kElbow[s])];
     if (m.calibration.offset[index(kElbow[s])].valid && et.seen) {
@@ -453,8 +451,8 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
   // 5. Legs.
   if (!st.started) st.pelvis_velocity = Vec3::Zero();
   if (st.started && dt > 0.0) {
-    st.pelvis_velocity +=
-        smoothing(dt, o.velocity_time_constant_s) * ((pelvis_now - st.last_pelvis) / dt - st.pelvis_velocity);
+    st.pelvis_velocity += detail::first_order_share(dt, o.velocity_time_constant_s) *
+                          ((pelvis_now - st.last_pelvis) / dt - st.pelvis_velocity);
   }
   st.last_pelvis = pelvis_now;
   const double pelvis_yaw = yaw_of(w.f.rot[0] * Vec3::UnitX(), yaw);
@@ -492,7 +490,8 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     const Vec3 raw_knee = (foot_fwd.norm() > 1e-6 ? Vec3(foot_fwd.normalized()) : Vec3::Zero()) +
                           kPelvisKneeWeight * (pelvis_fwd.norm() > 1e-6 ? Vec3(pelvis_fwd.normalized()) : Vec3::Zero());
     // Smoothed as the elbows' (a foot's quick turns are the ankle's).
-    smooth_pole(st.knee_pole[s], raw_knee, body_yaw * Vec3::UnitX(), !st.started, smoothing(dt, o.knee_smoothing_s));
+    smooth_pole(st.knee_pole[s], raw_knee, body_yaw * Vec3::UnitX(), !st.started,
+                detail::first_order_share(dt, o.knee_smoothing_s));
     Vec3 pole = st.knee_pole[s];
     IkState::Track& kt = st.track[index(kKnee[s])];
     if (m.calibration.offset[index(kKnee[s])].valid && kt.seen) {
