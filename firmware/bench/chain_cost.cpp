@@ -47,15 +47,18 @@ class NullHal final : public hal::EmgSampler,
     return true;
   }
   [[nodiscard]] std::uint64_t now_us() const override { return now_; }
-  [[nodiscard]] std::size_t size() const override { return 0; }
+  [[nodiscard]] std::size_t sector_size() const override { return 0; }
+  [[nodiscard]] std::size_t sector_count() const override { return 0; }
   bool read(std::size_t, std::span<std::uint8_t>) override { return false; }
-  bool erase() override { return false; }
+  bool erase(std::size_t) override { return false; }
   bool program(std::size_t, std::span<const std::uint8_t>) override { return false; }
   void show(hal::LedPattern) override {}
   void kick() override {}
   [[nodiscard]] bool caused_last_reset() const override { return false; }
   void reset() override {}
   [[nodiscard]] bool connected() const override { return true; }
+  void service() override {}
+  [[nodiscard]] bool idle() const override { return true; }
   bool send_input(const proto::hid::Report& r) override {
     g_sink = g_sink + static_cast<float>(r[20]);
     return true;

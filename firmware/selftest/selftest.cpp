@@ -52,14 +52,16 @@ class SyntheticSampler final : public hal::EmgSampler {
 
 class RamStorage final : public hal::Storage {
  public:
-  [[nodiscard]] std::size_t size() const override { return bytes_.size(); }
+  [[nodiscard]] std::size_t sector_size() const override { return kSector; }
+  [[nodiscard]] std::size_t sector_count() const override { return 2; }
   bool read(std::size_t offset, std::span<std::uint8_t> out) override {
     if (offset + out.size() > bytes_.size()) return false;
     for (std::size_t k = 0; k < out.size(); ++k) out[k] = bytes_[offset + k];
     return true;
   }
-  bool erase() override {
-    bytes_.fill(0xFF);
+  bool erase(std::size_t sector) override {
+    if (sector >= 2) return false;
+    for (std::size_t k = 0; k < kSector; ++k) bytes_[sector * kSector + k] = 0xFF;
     return true;
   }
   bool program(std::size_t offset, std::span<const std::uint8_t> data) override {
@@ -70,7 +72,8 @@ class RamStorage final : public hal::Storage {
   RamStorage() { bytes_.fill(0xFF); }
 
  private:
-  std::array<std::uint8_t, 4 * kRecordSlot> bytes_{};
+  static constexpr std::size_t kSector = 2 * kRecordSlot;
+  std::array<std::uint8_t, 2 * kSector> bytes_{};
 };
 
 class Nothing final : public hal::StatusLed, public hal::Watchdog, public hal::SystemControl {
@@ -182,9 +185,12 @@ void run_selftest(SelftestResult& out, SelftestSink sink, void* context, TickCou
   static Device device(board);
 
   static Collector c{};
-  c = Collector{&out, sink, context, static_cast<std::uint32_t>(gen.total_frames() / 2)};
+  c = Collector{&out, sink, context, 0};
   device.set_report_observer(&queue, &c);
   device.boot();
+  // Reports in the run at the configured rate (the mid-point report is sampled).
+  c.total_reports =
+      static_cast<std::uint32_t>(gen.total_frames() * device.config().report_rate_hz / device.config().sample_rate_hz);
   while (sampler.produce()) {
     if (ticks == nullptr) {
       device.poll();

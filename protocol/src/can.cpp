@@ -26,9 +26,10 @@ constexpr std::size_t values_in_frame(std::size_t values, std::size_t per_frame,
   return left < per_frame ? left : per_frame;
 }
 
-CanFrame frame_for(Function f, std::uint8_t node) {
+CanFrame frame_for(Function f, std::uint8_t node, std::uint32_t id_base) {
   CanFrame fr{};
-  fr.id = make_id(f, node);
+  fr.id = make_id(f, node, id_base);
+  if (id_base != 0) fr.flags = CanFrame::kExtended;
   return fr;
 }
 
@@ -63,17 +64,24 @@ bool split_id(std::uint32_t id, Function& f, std::uint8_t& node) {
   return false;
 }
 
+bool split_frame(const CanFrame& frame, std::uint32_t id_base, Function& f, std::uint8_t& node) {
+  const bool extended = (frame.flags & CanFrame::kExtended) != 0;
+  if ((frame.flags & (CanFrame::kRemote | CanFrame::kErrorFrame)) != 0 || extended != (id_base != 0)) return false;
+  if (frame.id < id_base || (frame.id & ~std::uint32_t{0x7FF}) != id_base) return false;
+  return split_id(frame.id - id_base, f, node);
+}
+
 Error encode_stream(const StreamMessage& msg, std::uint8_t node, bool with_envelopes, std::span<CanFrame> out,
-                    std::size_t& count) {
+                    std::size_t& count, std::uint32_t id_base) {
   count = 0;
-  if (node > kMaxNodeId) return Error::bad_value;
+  if (node > kMaxNodeId || !valid_id_base(id_base)) return Error::bad_value;
   if (Error e = validate(msg); e != Error::ok) return e;
   const std::size_t level_frames = frames_for(msg.group_count, kGroupsPerFrame);
   const std::size_t env_frames = with_envelopes ? frames_for(msg.channel_count, kChannelsPerFrame) : 0;
   if (out.size() < 2 + level_frames + env_frames) return Error::buffer_too_small;
 
   std::size_t n = 0;
-  CanFrame status = frame_for(Function::status, node);
+  CanFrame status = frame_for(Function::status, node, id_base);
   ByteWriter ws(status.data);
   ws.u16(msg.sequence);
   ws.u32(msg.device_time_us);
@@ -83,19 +91,19 @@ Error encode_stream(const StreamMessage& msg, std::uint8_t node, bool with_envel
   out[n++] = status;
 
   for (std::size_t k = 0; k < level_frames; ++k) {
-    CanFrame fr = frame_for(data_function(k), node);
+    CanFrame fr = frame_for(data_function(k), node, id_base);
     put_values(
         fr, std::span(msg.levels).subspan(k * kGroupsPerFrame, values_in_frame(msg.group_count, kGroupsPerFrame, k)));
     out[n++] = fr;
   }
   for (std::size_t k = 0; k < env_frames; ++k) {
-    CanFrame fr = frame_for(data_function(kLevelFrames + k), node);
+    CanFrame fr = frame_for(data_function(kLevelFrames + k), node, id_base);
     put_values(fr, std::span(msg.envelopes)
                        .subspan(k * kChannelsPerFrame, values_in_frame(msg.channel_count, kChannelsPerFrame, k)));
     out[n++] = fr;
   }
 
-  CanFrame flags = frame_for(Function::flags, node);
+  CanFrame flags = frame_for(Function::flags, node, id_base);
   ByteWriter wf(flags.data);
   wf.u16(msg.electrode_off);
   wf.u16(msg.saturation);
@@ -118,8 +126,7 @@ Error StreamAssembler::push(const CanFrame& frame, bool& complete) {
   Function f{};
   std::uint8_t node = 0;
   // Other traffic on a shared bus is normal: ignore it quietly.
-  if ((frame.flags & (CanFrame::kExtended | CanFrame::kRemote | CanFrame::kErrorFrame)) != 0) return Error::ok;
-  if (!split_id(frame.id, f, node) || node != node_) return Error::ok;
+  if (!split_frame(frame, id_base_, f, node) || node != node_) return Error::ok;
   if (frame.dlc > 8) return Error::bad_length;
 
   switch (f) {
@@ -242,8 +249,8 @@ Error StreamAssembler::push(const CanFrame& frame, bool& complete) {
   return Error::ok;
 }
 
-CanFrame encode_heartbeat(const Heartbeat& hb, std::uint8_t node) {
-  CanFrame fr = frame_for(Function::heartbeat, node);
+CanFrame encode_heartbeat(const Heartbeat& hb, std::uint8_t node, std::uint32_t id_base) {
+  CanFrame fr = frame_for(Function::heartbeat, node, id_base);
   ByteWriter w(fr.data);
   w.u8(static_cast<std::uint8_t>(hb.state));
   w.u8(hb.protocol_version);
@@ -253,10 +260,10 @@ CanFrame encode_heartbeat(const Heartbeat& hb, std::uint8_t node) {
   return fr;
 }
 
-Error decode_heartbeat(const CanFrame& frame, Heartbeat& out) {
+Error decode_heartbeat(const CanFrame& frame, Heartbeat& out, std::uint32_t id_base) {
   Function f{};
   std::uint8_t node = 0;
-  if (frame.flags != 0 || !split_id(frame.id, f, node) || f != Function::heartbeat) return Error::bad_type;
+  if (!split_frame(frame, id_base, f, node) || f != Function::heartbeat) return Error::bad_type;
   if (frame.dlc != 8) return Error::bad_length;
   ByteReader r(frame.payload());
   const std::uint8_t state = r.u8();
@@ -271,15 +278,15 @@ Error decode_heartbeat(const CanFrame& frame, Heartbeat& out) {
 }
 
 Error segment(std::span<const std::uint8_t> message, Function f, std::uint8_t node, std::span<CanFrame> out,
-              std::size_t& count) {
+              std::size_t& count, std::uint32_t id_base) {
   count = 0;
-  if (node > kMaxNodeId) return Error::bad_value;
+  if (node > kMaxNodeId || !valid_id_base(id_base)) return Error::bad_value;
   if (f != Function::request && f != Function::response) return Error::bad_type;
   if (message.empty() || message.size() > kMaxMessageSize) return Error::bad_length;
   const std::size_t total = frames_for(message.size(), kSegmentData);
   if (out.size() < total) return Error::buffer_too_small;
   for (std::size_t i = 0; i < total; ++i) {
-    CanFrame fr = frame_for(f, node);
+    CanFrame fr = frame_for(f, node, id_base);
     const std::size_t n = values_in_frame(message.size(), kSegmentData, i);
     fr.data[0] = static_cast<std::uint8_t>((total << 4U) | i);
     for (std::size_t j = 0; j < n; ++j) fr.data[1 + j] = message[i * kSegmentData + j];
@@ -300,7 +307,7 @@ Error Reassembler::push(const CanFrame& frame, bool& complete) {
   complete = false;
   Function f{};
   std::uint8_t node = 0;
-  if (frame.flags != 0 || !split_id(frame.id, f, node) || f != function_ || node != node_) return Error::ok;
+  if (!split_frame(frame, id_base_, f, node) || f != function_ || node != node_) return Error::ok;
   if (frame.dlc < 2 || frame.dlc > 8) {
     reset();
     return Error::bad_length;

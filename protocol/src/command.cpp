@@ -10,13 +10,15 @@ bool is_known(Opcode op) {
     case Opcode::get_device_info:
     case Opcode::time_sync:
     case Opcode::get_stats:
+    case Opcode::get_log:
     case Opcode::calibration_start:
     case Opcode::calibration_abort:
     case Opcode::calibration_status:
     case Opcode::get_config:
     case Opcode::set_config:
     case Opcode::save_config:
-    case Opcode::reset: return true;
+    case Opcode::reset:
+    case Opcode::enter_bootloader: return true;
   }
   return false;
 }

@@ -34,6 +34,11 @@ void DeviceInfo::write(ByteWriter& w) const {
   w.u16(report_rate_hz);
   w.bytes(pair_group);
   w.u8(transports);
+  w.u8(protocol_minor);
+  w.u32(features);
+  w.u32(build_id);
+  w.u32(boot_count);
+  w.u8(static_cast<std::uint8_t>(reset_cause));
 }
 
 Error DeviceInfo::read(ByteReader& r) {
@@ -51,6 +56,15 @@ Error DeviceInfo::read(ByteReader& r) {
   r.bytes(pair_group);
   transports = r.u8();
   if (!r.ok()) return r.error();
+  if (r.remaining() >= kWireSize - kMinWireSize) {  // minor 1 fields
+    protocol_minor = r.u8();
+    features = r.u32();
+    build_id = r.u32();
+    boot_count = r.u32();
+    const std::uint8_t cause = r.u8();
+    if (cause > static_cast<std::uint8_t>(ResetCause::low_power)) return Error::bad_value;
+    reset_cause = static_cast<ResetCause>(cause);
+  }
   if (channel_count < 1 || channel_count > kMaxChannels) return Error::bad_length;
   if (group_count < 1 || group_count > kMaxGroups) return Error::bad_length;
   if (pair_count > kMaxPairs || pair_count * 2U > channel_count) return Error::bad_length;
@@ -157,6 +171,7 @@ void DeviceConfig::write(ByteWriter& w) const {
   w.u16(curve_exponent_milli);
   w.u8(can_node_id);
   w.u8(can_envelope_divider);
+  w.u32(can_id_base);
 }
 
 Error DeviceConfig::read(ByteReader& r) {
@@ -181,6 +196,8 @@ Error DeviceConfig::read(ByteReader& r) {
   curve_exponent_milli = r.u16();
   can_node_id = r.u8();
   can_envelope_divider = r.u8();
+  if (!r.ok()) return r.error();
+  if (r.remaining() >= kWireSize - kMinWireSize) can_id_base = r.u32();  // minor 1
   return r.error();
 }
 
@@ -203,6 +220,7 @@ const char* to_string(ConfigField f) {
     case ConfigField::curve_exponent_milli: return "curve_exponent_milli";
     case ConfigField::can_node_id: return "can_node_id";
     case ConfigField::can_envelope_divider: return "can_envelope_divider";
+    case ConfigField::can_id_base: return "can_id_base";
   }
   return "unknown field";
 }
@@ -231,6 +249,7 @@ ConfigField check_config(const DeviceConfig& c, std::uint8_t group_count) {
   if (raw(c.curve) > raw(LevelCurve::power)) return ConfigField::curve;
   if (c.curve_exponent_milli < 100 || c.curve_exponent_milli > 10000) return ConfigField::curve_exponent_milli;
   if (c.can_node_id > 31) return ConfigField::can_node_id;
+  if (c.can_id_base % 0x800U != 0 || c.can_id_base > 0x1FFFF800U) return ConfigField::can_id_base;
   return ConfigField::none;
 }
 
@@ -239,7 +258,7 @@ void SetConfigResult::write(ByteWriter& w) const { w.u8(raw(rejected)); }
 Error SetConfigResult::read(ByteReader& r) {
   const std::uint8_t v = r.u8();
   if (!r.ok()) return r.error();
-  if (v != raw(ConfigField::none) && v > raw(ConfigField::can_envelope_divider)) return Error::bad_value;
+  if (v != raw(ConfigField::none) && v > raw(ConfigField::can_id_base)) return Error::bad_value;
   rejected = static_cast<ConfigField>(v);
   return Error::ok;
 }
@@ -248,6 +267,43 @@ void ResetRequest::write(ByteWriter& w) const { w.u8(raw(kind)); }
 
 Error ResetRequest::read(ByteReader& r) {
   return read_enum(r, kind, raw(ResetKind::reboot), raw(ResetKind::factory_defaults));
+}
+
+void FaultLog::write(ByteWriter& w) const {
+  w.u8(count);
+  w.u8(more);
+  w.u16(dropped);
+  for (const LogEntry& e : entries) {
+    w.u32(e.time_ms);
+    w.u8(static_cast<std::uint8_t>(e.code));
+    w.u8(e.repeats);
+    w.u16(e.arg);
+  }
+}
+
+Error FaultLog::read(ByteReader& r) {
+  count = r.u8();
+  more = r.u8();
+  dropped = r.u16();
+  for (LogEntry& e : entries) {
+    e.time_ms = r.u32();
+    const std::uint8_t code = r.u8();
+    e.repeats = r.u8();
+    e.arg = r.u16();
+    e.code = static_cast<FaultCode>(code);
+  }
+  if (!r.ok()) return r.error();
+  if (count > kMaxEntries || more > 1) return Error::bad_value;
+  // Unused slots are zero on the wire, so equal bytes give equal logs; used ones carry a known code.
+  for (std::size_t k = 0; k < kMaxEntries; ++k) {
+    const auto code = static_cast<std::uint8_t>(entries[k].code);
+    if (k < count && (code < 1 || code > static_cast<std::uint8_t>(FaultCode::config_rejected)))
+      return Error::bad_value;
+    if (k >= count && (code != 0 || entries[k].time_ms != 0 || entries[k].arg != 0 || entries[k].repeats != 0)) {
+      return Error::bad_value;
+    }
+  }
+  return Error::ok;
 }
 
 }  // namespace tonus::proto

@@ -2,23 +2,38 @@
 
 namespace tonus::proto {
 
-SequenceTracker::Verdict SequenceTracker::push(std::uint16_t seq) {
+SequenceTracker::Verdict SequenceTracker::restart(std::uint16_t seq, std::uint8_t boot_epoch) {
+  ++resyncs_;
+  epoch_ = boot_epoch;
+  newest_ = seq;
+  history_ = 1;
+  ++received_;
+  return Verdict::resync;
+}
+
+void SequenceTracker::note_restart() {
+  if (!started_) return;  // nothing counted yet: the next report is simply the first
+  started_ = false;
+  ++resyncs_;
+}
+
+SequenceTracker::Verdict SequenceTracker::push(std::uint16_t seq, std::uint8_t boot_epoch) {
+  const bool reconnected = reconnected_;
+  reconnected_ = false;
   if (!started_) {
     started_ = true;
+    epoch_ = boot_epoch;
     newest_ = seq;
     history_ = 1;
     ++received_;
     return Verdict::first;
   }
+  if (boot_epoch != epoch_) return restart(seq, boot_epoch);
   // Signed distance modulo 2^16: positive means newer.
   const auto ahead = static_cast<std::int16_t>(static_cast<std::uint16_t>(seq - newest_));
   const int distance = ahead;
-  if (distance > kResyncThreshold || distance < -kResyncThreshold) {
-    ++resyncs_;
-    newest_ = seq;
-    history_ = 1;
-    ++received_;
-    return Verdict::resync;
+  if (distance > kResyncThreshold || distance < -kResyncThreshold || (reconnected && distance <= 0)) {
+    return restart(seq, boot_epoch);
   }
   if (distance > 0) {
     lost_ += static_cast<std::uint64_t>(distance - 1);

@@ -28,7 +28,7 @@ Error encode_stream(const StreamMessage& msg, std::span<std::uint8_t> out, std::
   w.u8(kProtocolVersion);
   w.u8(msg.group_count);
   w.u8(msg.channel_count);
-  w.u8(0);  // reserved
+  w.u8(msg.boot_epoch);
   w.u16(msg.sequence);
   w.u32(msg.device_time_us);
   w.u16(msg.status);
@@ -51,7 +51,7 @@ Error decode_stream(std::span<const std::uint8_t> in, StreamMessage& out) {
   StreamMessage m{};
   m.group_count = r.u8();
   m.channel_count = r.u8();
-  r.skip(1);  // reserved
+  m.boot_epoch = r.u8();  // byte 3 was reserved (sent 0) in version 1.0
   m.sequence = r.u16();
   m.device_time_us = r.u32();
   m.status = r.u16();

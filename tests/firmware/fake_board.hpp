@@ -4,6 +4,7 @@
 #pragma once
 
 #include <deque>
+#include <functional>
 #include <vector>
 
 #include "sim_hal.hpp"
@@ -19,6 +20,8 @@ class QueueHid final : public hal::UsbHid {
     sent.push_back(r);
     return true;
   }
+  void service() override {}
+  [[nodiscard]] bool idle() const override { return true; }
   bool receive_output(proto::hid::Report& r, std::size_t& length) override {
     if (inbox.empty()) return false;
     r.fill(0);
@@ -38,6 +41,7 @@ class QueueCan final : public hal::CanPort {
     sent.push_back(f);
     return true;
   }
+  [[nodiscard]] bool idle() const override { return true; }
   bool receive(proto::CanFrame& f) override {
     if (inbox.empty()) return false;
     f = inbox.front();
@@ -91,7 +95,12 @@ struct Bench {
                                                                     static_cast<double>(gen.spec().sample_rate_hz)));
     if (!gen.lose_block(first, n)) sampler.push(b);
     dev.poll();
-    if (system.take_reset()) dev.boot();
+    if (system.take_reset()) {
+      ++reboots;
+      if (on_reset) on_reset();  // e.g. what a chip reset does to the USB controller
+      dev.boot();
+    }
+    if (after_pass) after_pass();  // e.g. the USB host's IN token of this 1 ms frame
     return true;
   }
   void run_for(fw::Device& dev, float seconds) {
@@ -111,6 +120,9 @@ struct Bench {
   QueueHid hid;
   QueueCan can;
   std::uint32_t sequence = 0;
+  int reboots = 0;
+  std::function<void()> on_reset;
+  std::function<void()> after_pass;
 
  private:
   std::size_t block_frames_;

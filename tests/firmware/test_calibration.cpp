@@ -7,6 +7,7 @@
 #include "sim_hal.hpp"
 #include "tonus/firmware/calibration.hpp"
 #include "tonus/firmware/nv_record.hpp"
+#include "tonus/protocol/crc16.hpp"
 
 using namespace tonus;
 using namespace tonus::fw;
@@ -156,15 +157,22 @@ TEST_CASE("persisted record: round trip, corruption, old version, torn newest re
   SUBCASE("a record of another version is not read") {
     sim::FlashStorage old;
     std::array<std::uint8_t, kRecordSlot> slot{};
-    encode_record(a, slot);
-    slot[4] = kRecordVersion + 1;
+    const std::size_t n = encode_record(a, 1, slot);
+    slot[4] = kRecordVersion + 1;  // a newer firmware's record, with a valid CRC
+    const std::uint16_t crc = proto::crc16_ccitt(std::span<const std::uint8_t>(slot).first(n - 2));
+    slot[n - 2] = static_cast<std::uint8_t>(crc & 0xFFU);
+    slot[n - 1] = static_cast<std::uint8_t>(crc >> 8U);
     old.program(0, slot);
     CHECK(load_persisted(old, out) == LoadResult::old_version);
   }
-  SUBCASE("a full log is erased and restarted") {
-    for (std::size_t k = 0; k < sim::FlashStorage::kSize / kRecordSlot + 3; ++k) REQUIRE(save_persisted(flash, b));
-    REQUIRE(load_persisted(flash, out) == LoadResult::loaded);
-    CHECK(out == b);
+  SUBCASE("full sectors: the log moves to the other sector and back, newest always wins") {
+    for (std::size_t k = 0; k < 3 * sim::FlashStorage::kSize / kRecordSlot + 3; ++k) {
+      Persisted p = b;
+      p.config.envelope_tau_ms = static_cast<std::uint16_t>(20 + k % 200);
+      REQUIRE(save_persisted(flash, p));
+      REQUIRE(load_persisted(flash, out) == LoadResult::loaded);
+      REQUIRE(out == p);
+    }
   }
 }
 

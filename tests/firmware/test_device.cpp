@@ -69,7 +69,7 @@ TEST_CASE("boot on empty storage: defaults, not calibrated") {
   CHECK((dev.status_bits() & proto::status_bit::calibrated) == 0);
   CHECK(b.led.pattern() == hal::LedPattern::uncalibrated);
   b.run_for(dev, 0.5F);
-  CHECK(dev.reports() == 500);
+  CHECK(dev.reports() == 250);  // the default 500 Hz report rate
   CHECK(b.watchdog.kicks() > 0);
 }
 
@@ -99,7 +99,7 @@ TEST_CASE("commands: device info, time sync, stats, config") {
   rsp = ask(b, dev, proto::make_request(proto::Opcode::get_stats, 3));
   proto::DeviceStats st{};
   REQUIRE(proto::read_payload(rsp, st) == proto::Error::ok);
-  CHECK(st.reports_sent >= 100);
+  CHECK(st.reports_sent >= 50);
   CHECK(st.lost_blocks == 0);
 
   rsp = ask(b, dev, proto::make_request(proto::Opcode::get_config, 4));
@@ -232,6 +232,7 @@ TEST_CASE("a lost block is counted and flagged once; a repeated block is never p
   const std::uint32_t before = dev.reports();
   b.sequence += 3;  // three blocks overwritten by the DMA
   b.step(dev);
+  b.step(dev);  // two 1 ms blocks: one report at 500 Hz
   CHECK(dev.stats().lost_blocks == 3);
   CHECK(dev.reports() == before + 1);
   std::uint16_t flagged = 0;
@@ -264,9 +265,9 @@ TEST_CASE("a block processed long after it was sampled is counted late, and stil
   // The main loop stalled for 10 ms (e.g. a flash erase): the next block is old news.
   hal::SampleBlock late{};
   late.sequence = b.sequence++;
-  late.frames = 2;
+  late.frames = 4;  // 2 ms: one report at 500 Hz
   late.first_sample_us = b.clock.now_us();
-  b.clock.advance_to(late.first_sample_us + 10000);
+  b.clock.advance_to(late.first_sample_us + 12000);
   b.sampler.push(late);
   dev.poll();
   CHECK(dev.stats().late_blocks == 1);
@@ -377,8 +378,10 @@ TEST_CASE("calibration over commands; the host disappearing mid-phase leaves a c
   CHECK(dev.calibration().baseline_mask == 0xFF);
   CHECK((dev.status_bits() & proto::status_bit::config_dirty) != 0);  // in RAM only
   {
-    Persisted p{};
-    CHECK(load_persisted(b.storage, p) == LoadResult::empty);
+    Persisted p{};  // the storage holds only the boot's record (its boot count), uncalibrated
+    REQUIRE(load_persisted(b.storage, p) == LoadResult::loaded);
+    CHECK(p.calibration.baseline_mask == 0);
+    CHECK(p.boot_count == 1);
   }
   // A host comes back, runs the MVC at the top of the ramp, and saves.
   b.run_for(dev, 16.0F);
@@ -415,6 +418,7 @@ TEST_CASE("a co-contraction ramp through the whole device: levels rise with it; 
     std::vector<std::array<double, kGroups>> second_means;
     std::array<double, kGroups> acc{};
     int n = 0;
+    int per_second = 0;  // reports
   };
   const auto run = [](std::uint16_t hysteresis, Track& track) {
     Bench b(spec(Scenario::ramp, 10.0F));
@@ -425,6 +429,7 @@ TEST_CASE("a co-contraction ramp through the whole device: levels rise with it; 
     cfg.hysteresis = hysteresis;
     proto::Response rsp = ask(b, dev, request(proto::Opcode::set_config, 1, cfg));
     REQUIRE(rsp.status == proto::Status::ok);
+    track.per_second = cfg.report_rate_hz;
     dev.set_report_observer(
         [](void* ctx, const proto::StreamMessage& m) {
           auto& t = *static_cast<Track*>(ctx);
@@ -433,8 +438,8 @@ TEST_CASE("a co-contraction ramp through the whole device: levels rise with it; 
             t.last[g] = m.levels[g];
             t.acc[g] += m.levels[g];
           }
-          if (++t.n == 1000) {
-            for (double& a : t.acc) a /= 1000.0;
+          if (++t.n == t.per_second) {
+            for (double& a : t.acc) a /= t.per_second;
             t.second_means.push_back(t.acc);
             t.acc = {};
             t.n = 0;
@@ -447,7 +452,7 @@ TEST_CASE("a co-contraction ramp through the whole device: levels rise with it; 
   Track with, without;
   run(proto::DeviceConfig{}.hysteresis, with);
   run(0, without);
-  REQUIRE(with.second_means.size() == 9);
+  REQUIRE(with.second_means.size() >= 9);
   for (std::size_t g = 0; g < kGroups; ++g) {
     INFO("group " << g);
     // Rest for the first second, then rising every second until full scale.
@@ -456,7 +461,7 @@ TEST_CASE("a co-contraction ramp through the whole device: levels rise with it; 
       CHECK(with.second_means[s][g] >= std::min(with.second_means[s - 1][g] + 500.0, 0.99 * 65535));
     }
     CHECK(with.last[g] > 0.8 * 65535);
-    MESSAGE("group " << g << ": level changes in 10000 reports: " << with.changes[g] << " with hysteresis, "
+    MESSAGE("group " << g << ": level changes in 10 s of reports: " << with.changes[g] << " with hysteresis, "
                      << without.changes[g] << " without");
     CHECK(with.changes[g] * 4 < without.changes[g]);
   }
@@ -480,6 +485,7 @@ TEST_CASE("CAN: segmented request and response, stream cycles and heartbeat") {
   for (std::size_t k = 0; k < count; ++k) b.can.inbox.push_back(frames[k]);
   b.can.sent.clear();
   b.step(dev);
+  b.step(dev);  // two 1 ms blocks: one stream cycle at 500 Hz
   proto::can::Reassembler reasm(proto::can::Function::response, 1);
   proto::can::StreamAssembler stream(1);
   bool got_response = false;
@@ -560,6 +566,70 @@ TEST_CASE("CAN: a set_config that changes the node id is answered from the old i
   CHECK_FALSE(ask_can(proto::make_request(proto::Opcode::get_config, 11), old_id, old_id).has_value());
 }
 
+TEST_CASE("CAN id base: a band moved off the CANopen ids answers on the old plan, then streams on 29-bit ids") {
+  Bench b(spec(Scenario::rest, 2.0F));
+  hal::Board board = b.board();
+  Device dev(board);
+  dev.boot();
+  b.run_for(dev, 0.05F);
+  constexpr std::uint32_t kBase = 0x1A000000;
+  const std::uint8_t node = dev.config().can_node_id;
+  const auto ask_can = [&](const proto::Request& req, std::uint32_t base) {
+    std::array<std::uint8_t, proto::kMaxMessageSize> bytes{};
+    std::size_t n = 0;
+    REQUIRE(proto::encode_request(req, bytes, n) == proto::Error::ok);
+    std::array<proto::CanFrame, proto::can::kMaxSegments> frames{};
+    std::size_t count = 0;
+    REQUIRE(proto::can::segment(std::span<const std::uint8_t>(bytes).first(n), proto::can::Function::request, node,
+                                frames, count, base) == proto::Error::ok);
+    for (std::size_t k = 0; k < count; ++k) b.can.inbox.push_back(frames[k]);
+    b.can.sent.clear();
+    b.step(dev);
+    b.step(dev);
+    proto::can::Reassembler reasm(proto::can::Function::response, node, base);
+    std::optional<proto::Response> out;
+    for (const proto::CanFrame& f : b.can.sent) {
+      bool complete = false;
+      if (reasm.push(f, complete) != proto::Error::ok || !complete) continue;
+      proto::Response rsp{};
+      REQUIRE(proto::decode_response(reasm.message(), rsp) == proto::Error::ok);
+      out = rsp;
+    }
+    return out;
+  };
+  proto::DeviceConfig cfg = dev.config();
+  cfg.can_id_base = kBase + 1;  // not a multiple of 0x800: refused, nothing changes
+  const auto refused = ask_can(request(proto::Opcode::set_config, 1, cfg), 0);
+  REQUIRE(refused.has_value());
+  CHECK(refused->status == proto::Status::bad_value);
+  cfg.can_id_base = kBase;
+  const auto answer = ask_can(request(proto::Opcode::set_config, 2, cfg), 0);
+  REQUIRE(answer.has_value());  // answered on the 11-bit plan the request came on
+  CHECK(answer->status == proto::Status::ok);
+  // Now every frame is extended at the base: none may use an 11-bit (CANopen) id.
+  b.can.sent.clear();
+  b.run_for(dev, 1.1F);
+  int cycles = 0, heartbeats = 0;
+  proto::can::StreamAssembler stream(node, kBase);
+  for (const proto::CanFrame& f : b.can.sent) {
+    CHECK((f.flags & proto::CanFrame::kExtended) != 0);
+    CHECK((f.id & ~std::uint32_t{0x7FF}) == kBase);
+    bool complete = false;
+    REQUIRE(stream.push(f, complete) == proto::Error::ok);
+    if (complete) ++cycles;
+    proto::can::Heartbeat hb{};
+    if (proto::can::decode_heartbeat(f, hb, kBase) == proto::Error::ok) ++heartbeats;
+  }
+  CHECK(cycles >= 540);
+  CHECK(heartbeats == 1);
+  const auto next = ask_can(proto::make_request(proto::Opcode::get_config, 3), kBase);
+  REQUIRE(next.has_value());
+  proto::DeviceConfig back{};
+  REQUIRE(proto::read_payload(*next, back) == proto::Error::ok);
+  CHECK(back.can_id_base == kBase);
+  CHECK_FALSE(ask_can(proto::make_request(proto::Opcode::get_config, 4), 0).has_value());  // the old plan is gone
+}
+
 TEST_CASE("a stalled sampler is restarted once, then reported as a fault and the watchdog left to reset the chip") {
   Bench b(spec(Scenario::rest, 8.0F));
   hal::Board board = b.board();
@@ -604,4 +674,99 @@ TEST_CASE("a stalled sampler is restarted once, then reported as a fault and the
   CHECK_FALSE(dev.sampler_stalled());
   CHECK(heartbeat_state() == proto::can::NodeState::running);
   CHECK(b.watchdog.kicks() > kicks_stalled);
+}
+
+TEST_CASE("device info (minor 1): protocol minor, features, boot count across reboots, reset cause") {
+  Bench b(spec(Scenario::rest, 2.0F));
+  hal::Board board = b.board();
+  Device dev(board);
+  std::uint32_t last_boot = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (k == 0) {
+      dev.boot();
+    } else {
+      REQUIRE(ask(b, dev, request(proto::Opcode::reset, 9, proto::ResetRequest{})).status == proto::Status::ok);
+      for (int f = 0; f < 60 && b.reboots < k; ++f) b.step(dev);
+      REQUIRE(b.reboots == k);
+    }
+    proto::DeviceInfo info{};
+    REQUIRE(proto::read_payload(ask(b, dev, proto::make_request(proto::Opcode::get_device_info, 1)), info) ==
+            proto::Error::ok);
+    CHECK(info.protocol_minor == proto::kProtocolMinor);
+    CHECK((info.features & proto::feature_bit::fault_log) != 0);
+    CHECK((info.features & proto::feature_bit::bootloader) != 0);  // the simulator has one
+    CHECK(info.boot_count == last_boot + 1);                       // persisted with the configuration
+    last_boot = info.boot_count;
+    CHECK(info.reset_cause == (k == 0 ? proto::ResetCause::power_on : proto::ResetCause::software));
+  }
+  // A factory reset erases the count with the rest.
+  REQUIRE(
+      ask(b, dev, request(proto::Opcode::reset, 9, proto::ResetRequest{proto::ResetKind::factory_defaults})).status ==
+      proto::Status::ok);
+  for (int f = 0; f < 60 && b.reboots < 3; ++f) b.step(dev);
+  CHECK(dev.boot_count() == 1);
+}
+
+TEST_CASE("fault log: a stalled sampler is logged, read once, repeats merged, overflow counted") {
+  Bench b(spec(Scenario::rest, 2.0F));
+  hal::Board board = b.board();
+  Device dev(board);
+  dev.boot();
+  b.run_for(dev, 0.05F);
+  // The sampler stops delivering: a restart, then the stall.
+  for (int k = 0; k < 50; ++k) {
+    b.clock.advance_to(b.clock.now_us() + 10000);
+    dev.poll();
+  }
+  REQUIRE(dev.sampler_stalled());
+  proto::FaultLog log{};
+  REQUIRE(proto::read_payload(ask(b, dev, proto::make_request(proto::Opcode::get_log, 1)), log) == proto::Error::ok);
+  REQUIRE(log.count == 2);
+  CHECK(log.entries[0].code == proto::FaultCode::sampler_restarted);
+  CHECK(log.entries[1].code == proto::FaultCode::sampler_stalled);
+  CHECK(log.entries[1].time_ms > log.entries[0].time_ms);
+  CHECK(log.entries[1].time_ms - log.entries[0].time_ms >= kSamplerStallUs / 1000U);
+  CHECK(log.more == 0);
+  REQUIRE(proto::read_payload(ask(b, dev, proto::make_request(proto::Opcode::get_log, 2)), log) == proto::Error::ok);
+  CHECK(log.count == 0);  // read means removed
+
+  // The ring itself: merges, keeps the newest, counts what it dropped.
+  fw::FaultLog ring;
+  for (int k = 0; k < 300; ++k) ring.record(proto::FaultCode::blocks_lost, static_cast<std::uint16_t>(k), 5);
+  CHECK(ring.size() == 1);
+  for (std::uint32_t k = 0; k < 40; ++k) {
+    ring.record(k % 2 == 0 ? proto::FaultCode::can_down : proto::FaultCode::storage_error, 0, 10 + k);
+  }
+  CHECK(ring.size() == fw::kFaultLogCapacity);
+  CHECK(ring.dropped() == 41 - fw::kFaultLogCapacity);
+  proto::FaultLog out{};
+  ring.take(out);
+  CHECK(out.count == proto::FaultLog::kMaxEntries);
+  CHECK(out.more == 1);
+  CHECK(out.dropped == 41 - fw::kFaultLogCapacity);
+  CHECK(out.entries[0].time_ms == 10 + 40 - fw::kFaultLogCapacity);  // the oldest kept
+}
+
+TEST_CASE("enter_bootloader: answered first, then the board's bootloader; refused where there is none") {
+  Bench b(spec(Scenario::rest, 2.0F));
+  hal::Board board = b.board();
+  Device dev(board);
+  dev.boot();
+  b.run_for(dev, 0.02F);
+  const proto::Response rsp = ask(b, dev, proto::make_request(proto::Opcode::enter_bootloader, 4));
+  CHECK(rsp.status == proto::Status::ok);
+  for (int f = 0; f < 60 && b.reboots == 0; ++f) b.step(dev);
+  CHECK(b.system.bootloader_entries() == 1);
+  CHECK(b.reboots == 1);
+
+  // A board without an update bootloader says so.
+  struct NoBootloader final : hal::SystemControl {
+    void reset() override {}
+  } plain;
+  hal::Board other{b.sampler, b.clock, b.storage, b.led, b.watchdog, plain, &b.hid, &b.can, 42, 1};
+  Device dev2(other);
+  dev2.boot();
+  proto::Response r2{};
+  dev2.handle(proto::make_request(proto::Opcode::enter_bootloader, 5), 0, r2);
+  CHECK(r2.status == proto::Status::wrong_state);
 }

@@ -17,6 +17,8 @@ using namespace tonus::usb;
 
 namespace {
 
+// Like the real controller, EP1 IN holds one packet until the host's IN token
+// takes it, once per 1 ms frame (host_poll): never more than one per frame.
 struct FakeDcd final : Dcd {
   enum class Stage { none, data_in, data_out, status, stall };
   Stage last = Stage::none;
@@ -26,14 +28,20 @@ struct FakeDcd final : Dcd {
   int address = -1;
   bool status_after_address = false;
   bool hid_open = false;
-  bool in_busy = false;
-  std::vector<std::vector<std::uint8_t>> hid_packets;
+  bool in_halt = false;
+  bool out_halt = false;
+  int toggle_resets = 0;
+  std::vector<std::uint8_t> loaded;                    // in EP1's TX FIFO, not yet polled
+  std::vector<std::vector<std::uint8_t>> hid_packets;  // taken by the host
 
   void set_address(std::uint8_t a) override {
     address = a;
     status_after_address = false;
   }
-  void configure_hid_endpoints(bool open) override { hid_open = open; }
+  void configure_hid_endpoints(bool open) override {
+    hid_open = open;
+    loaded.clear();
+  }
   void ep0_send(std::span<const std::uint8_t> data, bool needs_zlp) override {
     sent.assign(data.begin(), data.end());
     zlp = needs_zlp;
@@ -49,9 +57,25 @@ struct FakeDcd final : Dcd {
   }
   void ep0_stall() override { last = Stage::stall; }
   bool hid_send(std::span<const std::uint8_t> packet) override {
-    if (in_busy || !hid_open) return false;
-    hid_packets.emplace_back(packet.begin(), packet.end());
+    if (!loaded.empty() || !hid_open || in_halt) return false;
+    loaded.assign(packet.begin(), packet.end());
     return true;
+  }
+  [[nodiscard]] bool hid_busy() const override { return !loaded.empty(); }
+  void hid_halt(bool in, bool halt) override {
+    (in ? in_halt : out_halt) = halt;
+    if (!halt) ++toggle_resets;
+  }
+  // The host's IN token of one frame: takes the loaded packet, if any.
+  void host_poll() {
+    if (loaded.empty() || in_halt) return;
+    hid_packets.push_back(loaded);
+    loaded.clear();
+  }
+  // A chip reset: whatever sat in the FIFO never leaves.
+  void chip_reset() {
+    loaded.clear();
+    hid_open = false;
   }
 };
 
@@ -200,10 +224,13 @@ TEST_CASE("HID data path: input reports on EP1, output reports from EP1 OUT or S
   CHECK_FALSE(core.send_input(r));  // not configured
   enumerate(core, dcd);
   CHECK(core.send_input(r));
+  CHECK(dcd.hid_busy());
+  dcd.host_poll();
   REQUIRE(dcd.hid_packets.size() == 1);
   CHECK(dcd.hid_packets[0].size() == 64);
-  dcd.in_busy = true;
-  CHECK_FALSE(core.send_input(r));  // previous packet not yet polled: dropped, counted by the caller
+  CHECK(core.idle());
+  r[0] = 9;
+  CHECK_FALSE(core.send_input(r));  // not an input report id
 
   std::size_t length = 0;
   CHECK_FALSE(core.receive_output(r, length));
@@ -232,37 +259,219 @@ TEST_CASE("HID data path: input reports on EP1, output reports from EP1 OUT or S
   CHECK(drained == 7);  // queue of 8, one slot kept free
 }
 
-TEST_CASE("the firmware core streams and answers through the USB stack") {
+namespace {
+
+// The firmware core on the USB stack, the host polling EP1 once per 1 ms block.
+struct UsbBench {
+  explicit UsbBench(float seconds, fw::Scenario scenario = fw::Scenario::rest) : b(spec(seconds, scenario)) {
+    b.after_pass = [this] { dcd.host_poll(); };
+  }
+  static fw::SynthSpec spec(float seconds, fw::Scenario scenario) {
+    fw::SynthSpec s;
+    s.scenario = scenario;
+    s.seconds = seconds;
+    return s;
+  }
+  hal::Board board() {
+    return hal::Board{b.sampler, b.clock, b.storage, b.led, b.watchdog, b.system, &core, nullptr, 99, 1};
+  }
+
+  std::vector<proto::StreamMessage> streams() const {
+    std::vector<proto::StreamMessage> out;
+    for (const auto& p : dcd.hid_packets) {
+      proto::StreamMessage m{};
+      if (p[0] == proto::hid::kReportIdStream && proto::hid::unpack_stream(p, m) == proto::Error::ok) out.push_back(m);
+    }
+    return out;
+  }
+  std::vector<proto::Response> responses() const {
+    std::vector<proto::Response> out;
+    for (const auto& p : dcd.hid_packets) {
+      proto::Response r{};
+      if (p[0] == proto::hid::kReportIdResponse && proto::hid::unpack_response(p, r) == proto::Error::ok)
+        out.push_back(r);
+    }
+    return out;
+  }
+  void request(proto::Opcode op, std::uint8_t token) {
+    proto::hid::Report req{};
+    REQUIRE(proto::hid::pack_request(proto::make_request(op, token), req) == proto::Error::ok);
+    core.on_hid_out(req);
+  }
+
   FakeDcd dcd;
-  DeviceCore core(dcd, 99);
-  fw::SynthSpec spec;
-  spec.scenario = fw::Scenario::rest;
-  spec.seconds = 1.0F;
-  test::Bench b(spec);
-  hal::Board board{b.sampler, b.clock, b.storage, b.led, b.watchdog, b.system, &core, nullptr, 99, 1};
+  DeviceCore core{dcd, 99};
+  test::Bench b;
+};
+
+// Stream reports received in order with no sequence gap.
+bool contiguous(const std::vector<proto::StreamMessage>& s) {
+  for (std::size_t k = 1; k < s.size(); ++k) {
+    if (static_cast<std::uint16_t>(s[k].sequence - s[k - 1].sequence) != 1) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+TEST_CASE("the firmware core streams and answers through the USB stack") {
+  UsbBench u(1.0F);
+  hal::Board board = u.board();
   fw::Device dev(board);
   dev.boot();
-  b.run_for(dev, 0.05F);
-  CHECK(dcd.hid_packets.empty());  // not enumerated: nothing sent, nothing counted as dropped
-  enumerate(core, dcd);
-  b.run_for(dev, 0.05F);
-  CHECK(dcd.hid_packets.size() == 50);
-  proto::StreamMessage m{};
-  CHECK(proto::hid::unpack_stream(dcd.hid_packets.back(), m) == proto::Error::ok);
+  u.b.run_for(dev, 0.05F);
+  CHECK(u.dcd.hid_packets.empty());  // not enumerated: nothing sent, nothing counted as dropped
+  enumerate(u.core, u.dcd);
+  u.b.run_for(dev, 0.05F);
+  CHECK(u.streams().size() == 25);  // 50 ms at the default 500 Hz
+  u.request(proto::Opcode::get_device_info, 5);
+  u.dcd.hid_packets.clear();
+  u.b.run_for(dev, 0.002F);
+  const auto r = u.responses();
+  REQUIRE(r.size() == 1);
+  CHECK(r[0].token == 5);
+  CHECK(r[0].status == proto::Status::ok);
+}
 
-  proto::hid::Report req{};
-  REQUIRE(proto::hid::pack_request(proto::make_request(proto::Opcode::get_device_info, 5), req) == proto::Error::ok);
-  core.on_hid_out(req);
-  dcd.hid_packets.clear();
-  b.run_for(dev, 0.002F);
-  bool answered = false;
-  for (const auto& p : dcd.hid_packets) {
-    proto::Response rsp{};
-    if (p[0] == proto::hid::kReportIdResponse && proto::hid::unpack_response(p, rsp) == proto::Error::ok) {
-      answered = rsp.token == 5 && rsp.status == proto::Status::ok;
-    }
+TEST_CASE("one IN packet per frame: 149 commands in 1.5 s cost no stream report at the default rate") {
+  // The audit's case: with the stream at 1 kHz every response displaced a
+  // report (149 of 1,500 lost). Now the reports and the answers share the frames.
+  UsbBench u(2.0F, fw::Scenario::ramp);
+  hal::Board board = u.board();
+  fw::Device dev(board);
+  dev.boot();
+  enumerate(u.core, u.dcd);
+  u.b.run_for(dev, 0.01F);
+  u.dcd.hid_packets.clear();
+  const std::uint32_t sent_before = dev.stats().reports_sent;
+  for (int k = 0; k < 1500; ++k) {
+    if (k % 10 == 3 && k / 10 < 149) u.request(proto::Opcode::get_stats, static_cast<std::uint8_t>(k / 10));
+    REQUIRE(u.b.step(dev));
   }
-  CHECK(answered);
+  u.b.run_for(dev, 0.004F);  // the last answer and report leave
+  const auto s = u.streams();
+  const auto r = u.responses();
+  CHECK(r.size() == 149);
+  CHECK(s.size() == dev.stats().reports_sent - sent_before);
+  CHECK(s.size() >= 750);
+  CHECK(contiguous(s));
+  CHECK(u.core.stream_superseded() == 0);
+  CHECK(dev.stats().tx_dropped == 0);
+  // Every frame carried at most one packet, by construction of the fake; and
+  // each answer came within 2 ms of its request.
+  CHECK(u.dcd.hid_packets.size() == s.size() + r.size());
+}
+
+TEST_CASE("at a 1 kHz report rate every response costs exactly one report, counted") {
+  UsbBench u(1.0F);
+  hal::Board board = u.board();
+  fw::Device dev(board);
+  dev.boot();
+  enumerate(u.core, u.dcd);
+  proto::DeviceConfig cfg = dev.config();
+  cfg.report_rate_hz = 1000;
+  proto::Request req{};
+  REQUIRE(proto::make_request(proto::Opcode::set_config, 1, cfg, req) == proto::Error::ok);
+  proto::hid::Report raw{};
+  REQUIRE(proto::hid::pack_request(req, raw) == proto::Error::ok);
+  u.core.on_hid_out(raw);
+  u.b.run_for(dev, 0.01F);
+  u.dcd.hid_packets.clear();
+  const std::uint32_t sent_before = dev.stats().reports_sent;
+  const std::uint32_t superseded_before = u.core.stream_superseded();
+  for (int k = 0; k < 500; ++k) {
+    if (k % 25 == 0) u.request(proto::Opcode::get_stats, static_cast<std::uint8_t>(k));
+    REQUIRE(u.b.step(dev));
+  }
+  u.b.run_for(dev, 0.003F);
+  const auto s = u.streams();
+  const std::uint32_t superseded = u.core.stream_superseded() - superseded_before;
+  CHECK(u.responses().size() == 20);
+  CHECK(superseded == 20);
+  CHECK(s.size() + superseded == dev.stats().reports_sent - sent_before);
+}
+
+TEST_CASE("reset: the answer leaves before the band reboots") {
+  UsbBench u(1.0F);
+  int answered_before_reboot = -1;
+  u.b.on_reset = [&] {
+    answered_before_reboot = static_cast<int>(u.responses().size());
+    u.dcd.chip_reset();  // a packet still in the FIFO dies with the chip
+    u.core.on_bus_reset();
+  };
+  hal::Board board = u.board();
+  fw::Device dev(board);
+  dev.boot();
+  enumerate(u.core, u.dcd);
+  u.b.run_for(dev, 0.02F);
+  proto::Request req{};
+  REQUIRE(proto::make_request(proto::Opcode::reset, 7, proto::ResetRequest{proto::ResetKind::reboot}, req) ==
+          proto::Error::ok);
+  proto::hid::Report raw{};
+  REQUIRE(proto::hid::pack_request(req, raw) == proto::Error::ok);
+  for (int k = 0; k < 40; ++k) {  // the request lands at every phase of the 500 Hz report clock
+    u.dcd.hid_packets.clear();
+    answered_before_reboot = -1;
+    const int reboots = u.b.reboots;
+    enumerate(u.core, u.dcd);
+    u.b.run_for(dev, 0.001F * static_cast<float>(1 + k % 3));
+    u.core.on_hid_out(raw);
+    for (int f = 0; f < 60 && u.b.reboots == reboots; ++f) REQUIRE(u.b.step(dev));
+    REQUIRE(u.b.reboots == reboots + 1);
+    CHECK(answered_before_reboot == 1);
+    const auto r = u.responses();
+    REQUIRE_FALSE(r.empty());
+    CHECK(r[0].token == 7);
+  }
+}
+
+TEST_CASE("suspend and resume: the configuration survives and the stream continues") {
+  UsbBench u(1.0F);
+  hal::Board board = u.board();
+  fw::Device dev(board);
+  dev.boot();
+  enumerate(u.core, u.dcd);
+  u.b.run_for(dev, 0.02F);
+  u.core.on_suspend();  // the host sleeps: no IN tokens
+  u.b.after_pass = nullptr;
+  u.b.run_for(dev, 0.05F);
+  CHECK_FALSE(u.core.connected());
+  u.core.on_resume();
+  u.b.after_pass = [&] { u.dcd.host_poll(); };
+  u.dcd.hid_packets.clear();
+  u.b.run_for(dev, 0.02F);
+  CHECK(u.core.connected());
+  CHECK(u.streams().size() >= 9);  // before: silent until a bus reset re-enumerated it
+  CHECK(u.core.suspends() == 1);
+  CHECK(u.core.resumes() == 1);
+}
+
+TEST_CASE("ENDPOINT_HALT stalls EP1 until cleared, GET_STATUS reports it, the toggle resets") {
+  UsbBench u(1.0F);
+  hal::Board board = u.board();
+  fw::Device dev(board);
+  dev.boot();
+  enumerate(u.core, u.dcd);
+  u.core.on_setup(setup(0x02, 3, 0, 0x81, 0));  // SET_FEATURE(ENDPOINT_HALT) on EP1 IN
+  CHECK(u.dcd.last == FakeDcd::Stage::status);
+  CHECK(u.dcd.in_halt);
+  u.core.on_setup(setup(0x82, 0, 0, 0x81, 2));  // GET_STATUS(endpoint 0x81)
+  CHECK(u.dcd.sent == std::vector<std::uint8_t>{1, 0});
+  u.b.run_for(dev, 0.01F);
+  CHECK(u.streams().empty());
+  u.core.on_setup(setup(0x02, 1, 0, 0x81, 0));  // CLEAR_FEATURE(ENDPOINT_HALT)
+  CHECK_FALSE(u.dcd.in_halt);
+  CHECK(u.dcd.toggle_resets == 1);
+  u.core.on_setup(setup(0x82, 0, 0, 0x81, 2));
+  CHECK(u.dcd.sent == std::vector<std::uint8_t>{0, 0});
+  u.b.run_for(dev, 0.01F);
+  CHECK(u.streams().size() >= 4);
+  u.core.on_setup(setup(0x02, 3, 0, 0x01, 0));  // EP1 OUT
+  CHECK(u.dcd.out_halt);
+  u.core.on_setup(setup(0x02, 3, 0, 0x85, 0));  // no such endpoint
+  CHECK(u.dcd.last == FakeDcd::Stage::stall);
+  u.core.on_setup(setup(0x00, 3, 1, 0, 0));  // DEVICE_REMOTE_WAKEUP: not supported
+  CHECK(u.dcd.last == FakeDcd::Stage::stall);
 }
 
 TEST_CASE("GET_REPORT over EP0 returns the last input report of that id, not zeros") {
@@ -273,6 +482,7 @@ TEST_CASE("GET_REPORT over EP0 returns the last input report of that id, not zer
   stream[0] = proto::hid::kReportIdStream;
   for (std::size_t k = 1; k < stream.size(); ++k) stream[k] = static_cast<std::uint8_t>(k * 3U);
   REQUIRE(core.send_input(stream));
+  dcd.host_poll();
   dcd.sent.clear();
   core.on_setup(setup(0xA1, 1, 0x0101, 0, 64));  // GET_REPORT, input, id 1
   REQUIRE(dcd.sent.size() == 64);
@@ -282,6 +492,7 @@ TEST_CASE("GET_REPORT over EP0 returns the last input report of that id, not zer
   response[0] = proto::hid::kReportIdResponse;
   response[5] = 0x5A;
   REQUIRE(core.send_input(response));
+  dcd.host_poll();
   dcd.sent.clear();
   core.on_setup(setup(0xA1, 1, 0x0103, 0, 64));
   REQUIRE(dcd.sent.size() == 64);

@@ -23,7 +23,10 @@ void check_payload(const Message& msg) {
   ByteWriter w(out);
   p.write(w);
   TONUS_FUZZ_CHECK(w.ok() && w.size() == Payload::kWireSize);
-  for (std::size_t i = 0; i < Payload::kWireSize; ++i) TONUS_FUZZ_CHECK(out[i] == msg.payload[i]);
+  // A payload of an older minor re-encodes its own bytes, then the appended
+  // fields at their defaults.
+  const std::size_t n = msg.length < Payload::kWireSize ? min_wire_size<Payload>() : Payload::kWireSize;
+  for (std::size_t i = 0; i < n; ++i) TONUS_FUZZ_CHECK(out[i] == msg.payload[i]);
 }
 
 template <class Message>
@@ -37,6 +40,7 @@ void check_all_payloads(const Message& msg) {
   check_payload<DeviceConfig>(msg);
   check_payload<SetConfigResult>(msg);
   check_payload<ResetRequest>(msg);
+  check_payload<FaultLog>(msg);
   DeviceConfig cfg{};
   if (read_payload(msg, cfg) == Error::ok) (void)check_config(cfg, 4);
 }

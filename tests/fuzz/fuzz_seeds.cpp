@@ -124,7 +124,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path root(argv[1]);
-  for (const char* t : {"stream", "command", "hid_descriptor", "can", "candump", "bvh"})
+  for (const char* t : {"stream", "command", "hid_descriptor", "can", "candump", "bvh", "device", "usb_control"})
     fs::create_directories(root / t);
   int n = 0;
 
@@ -151,6 +151,58 @@ int main(int argc, char** argv) {
   for (std::size_t i = 0; i < count; ++i) append_frame(frames, segs[i]);
   append_frame(frames, can::encode_heartbeat(can::Heartbeat{}, kNode));
   write(root / "can", n, frames);
+
+  // fuzz_device: [kind][length][bytes] chunks. Every request as a HID output
+  // report and as CAN segments to node 1, with sample blocks between them.
+  std::vector<std::uint8_t> device;
+  for (const Request& r : requests()) {
+    hid::Report report{};
+    (void)hid::pack_request(r, report);
+    device.push_back(0);
+    device.push_back(static_cast<std::uint8_t>(report.size()));
+    device.insert(device.end(), report.begin(), report.end());
+    device.insert(device.end(), {2, 16});
+    device.insert(device.end(), 16, 0x80);
+    std::array<CanFrame, can::kMaxSegments> parts{};
+    (void)can::segment(bytes_of(r, encode_request), can::Function::request, kNode, parts, count);
+    for (std::size_t i = 0; i < count; ++i) {
+      device.push_back(1);
+      device.push_back(static_cast<std::uint8_t>(2 + parts[i].dlc));
+      device.push_back(static_cast<std::uint8_t>(parts[i].id));
+      device.push_back(static_cast<std::uint8_t>(parts[i].id >> 8U));
+      device.insert(device.end(), parts[i].data.begin(), parts[i].data.begin() + parts[i].dlc);
+    }
+  }
+  write(root / "device", n, device);
+
+  // fuzz_usb_control: a Linux-like enumeration, a SET_REPORT with its data
+  // stage, an EP1 OUT request, a halt and a suspend.
+  const std::vector<std::array<std::uint8_t, 8>> setups{
+      {0x80, 6, 0x00, 0x01, 0, 0, 64, 0},  {0x00, 5, 7, 0, 0, 0, 0, 0},
+      {0x80, 6, 0x00, 0x02, 0, 0, 255, 0}, {0x80, 6, 0x03, 0x03, 0x09, 0x04, 255, 0},
+      {0x00, 9, 1, 0, 0, 0, 0, 0},         {0x21, 10, 0, 0, 0, 0, 0, 0},
+      {0x81, 6, 0x00, 0x22, 0, 0, 255, 0}, {0xA1, 1, 0x01, 0x01, 0, 0, 64, 0},
+      {0x02, 3, 0, 0, 0x81, 0, 0, 0},      {0x82, 0, 0, 0, 0x81, 0, 2, 0},
+      {0x02, 1, 0, 0, 0x81, 0, 0, 0},      {0x21, 9, 0x02, 0x02, 0, 0, 64, 0}};
+  std::vector<std::uint8_t> usb;
+  for (const auto& st : setups) {
+    usb.push_back(0);
+    usb.insert(usb.end(), st.begin(), st.end());
+  }
+  hid::Report out_report{};
+  (void)hid::pack_request(requests()[0], out_report);
+  usb.push_back(1);
+  usb.push_back(64);
+  usb.insert(usb.end(), out_report.begin(), out_report.end());
+  usb.push_back(2);
+  usb.push_back(64);
+  usb.insert(usb.end(), out_report.begin(), out_report.end());
+  usb.insert(usb.end(), {4, 5});
+  hid::Report in_report{};
+  (void)hid::pack_stream(stream_message(4, 8), in_report);
+  usb.insert(usb.end(), in_report.begin(), in_report.end());
+  usb.push_back(3);
+  write(root / "usb_control", n, usb);
 
   for (std::size_t i = 0; i < cycle.size(); ++i) {
     candump::Record rec{};

@@ -5,6 +5,8 @@
 #include <sys/socket.h>
 
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "sim_process.hpp"
 #include "tonus/host/transport/band_link.hpp"
@@ -58,13 +60,14 @@ TEST_CASE("HID link: continuous stream, device timestamps, command round trips, 
     REQUIRE(e.kind == host::LinkEvent::Kind::stream);
     stream(e.stream);
   }
-  CHECK(stream.gaps == 0);
-  CHECK(stream.last_step == 1000);  // 1 kHz reports on the device clock
-
   auto rsp = link.transact(proto::make_request(proto::Opcode::get_device_info, 1), 2000, sink);
   REQUIRE(rsp.has_value());
   proto::DeviceInfo info{};
   REQUIRE(proto::read_payload(*rsp, info) == proto::Error::ok);
+  REQUIRE(info.report_rate_hz > 0);
+  const std::uint32_t period_us = 1000000U / info.report_rate_hz;
+  CHECK(stream.gaps == 0);
+  CHECK(stream.last_step == period_us);  // reports at the device's rate, on its clock
   CHECK(info.channel_count == 8);
   CHECK(info.sample_rate_hz == 2000);
   CHECK((info.transports & proto::transport_bit::usb_hid) != 0);
@@ -118,9 +121,9 @@ TEST_CASE("HID link: continuous stream, device timestamps, command round trips, 
   REQUIRE(rsp.has_value());
   CHECK(rsp->status == proto::Status::unknown_opcode);
 
-  // Halve the report rate: the stream's device clock steps by 2 ms from then on.
+  // Halve the report rate: the stream's device clock steps twice as far from then on.
   proto::DeviceConfig slower = cfg;
-  slower.report_rate_hz = 500;
+  slower.report_rate_hz = static_cast<std::uint16_t>(cfg.report_rate_hz / 2);
   rsp = link.transact(request(proto::Opcode::set_config, 8, slower), 2000, sink);
   REQUIRE(rsp.has_value());
   CHECK(rsp->status == proto::Status::ok);
@@ -133,9 +136,9 @@ TEST_CASE("HID link: continuous stream, device timestamps, command round trips, 
   } while (e.kind != host::LinkEvent::Kind::closed && e.kind != host::LinkEvent::Kind::none);
   CHECK(e.kind == host::LinkEvent::Kind::closed);
   CHECK(stream.gaps == 0);
-  CHECK(stream.last_step == 2000);
-  CHECK(stream.count > 1500);
-  CHECK(stream.count < 3000);
+  CHECK(stream.last_step == 2 * period_us);
+  CHECK(stream.count > 3 * info.report_rate_hz / 2);  // 3 s, part at the full rate, part at half
+  CHECK(stream.count < 3 * info.report_rate_hz);
   CHECK(link.decode_errors() == 0);
   CHECK(sim.wait(5s) == 0);
 }
@@ -154,12 +157,13 @@ TEST_CASE("HID link over a listening socket in real time") {
   REQUIRE_MESSAGE(t, error);
   host::HidBandLink link(*t);
   std::uint64_t reports = 0;
-  std::uint32_t first = 0, last = 0;
+  std::uint32_t first = 0, last = 0, period_us = 0;
   const auto start = std::chrono::steady_clock::now();
   for (;;) {
     const host::LinkEvent e = link.poll(2000);
     if (e.kind != host::LinkEvent::Kind::stream) break;
     if (reports == 0) first = e.stream.device_time_us;
+    if (reports == 1) period_us = e.stream.device_time_us - first;
     last = e.stream.device_time_us;
     ++reports;
   }
@@ -167,7 +171,7 @@ TEST_CASE("HID link over a listening socket in real time") {
   const double device_s = (last - first) * 1e-6;
   MESSAGE("real time: " << reports << " reports over " << device_s << " s device time, " << wall_s << " s wall");
   CHECK(reports > 300);
-  CHECK(device_s == doctest::Approx(static_cast<double>(reports - 1) * 1e-3).epsilon(0.01));
+  CHECK(device_s == doctest::Approx(static_cast<double>(reports - 1) * period_us * 1e-6).epsilon(0.01));
   CHECK(wall_s > 0.8 * device_s);  // paced by the clock, not as fast as possible
   CHECK(sim.wait(5s) == 0);
 }
@@ -179,6 +183,13 @@ TEST_CASE("the host disappearing mid-calibration: the band neither hangs nor wri
   test::SimProcess sim(
       {"--synthetic", "rest", "--seconds", "30", "--fast", "--quiet", "--hid-fd", "3", "--storage", storage});
   REQUIRE(sim.started());
+  const auto contents = [&storage] {
+    std::ifstream in(storage, std::ios::binary);
+    std::ostringstream out;
+    out << in.rdbuf();
+    return out.str();
+  };
+  std::string at_boot;
   {
     host::SeqpacketHidTransport transport(sim.take_hid());
     host::HidBandLink link(transport);
@@ -187,9 +198,12 @@ TEST_CASE("the host disappearing mid-calibration: the band neither hangs nor wri
     const auto rsp = link.transact(request(proto::Opcode::calibration_start, 1, start), 2000);
     REQUIRE(rsp.has_value());
     CHECK(rsp->status == proto::Status::ok);
-  }  // the host closes its end here
+    at_boot = contents();  // the boot wrote its boot count, nothing since
+  }                        // the host closes its end here
   CHECK(sim.wait(10s) == 0);
-  CHECK_FALSE(std::filesystem::exists(storage));
+  CHECK_FALSE(at_boot.empty());
+  CHECK(contents() == at_boot);  // the abandoned calibration wrote nothing
+  std::filesystem::remove(storage);
 }
 
 TEST_CASE("hardware paths fail cleanly without hardware") {

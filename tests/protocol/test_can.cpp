@@ -302,3 +302,60 @@ TEST_CASE("reassembly: a missing, repeated or foreign segment voids the message;
   bad.dlc = 5;  // a short non-final segment
   CHECK(r.push(bad, complete) == Error::bad_length);
 }
+
+TEST_CASE("id base: the whole plan moves to 29-bit ids, clear of CANopen's 11-bit ones") {
+  CHECK(can::valid_id_base(0));
+  CHECK(can::valid_id_base(0x800));
+  CHECK(can::valid_id_base(can::kMaxIdBase));
+  CHECK_FALSE(can::valid_id_base(0x400));
+  CHECK_FALSE(can::valid_id_base(0x20000000));
+  constexpr std::uint32_t kBase = 0x12345000;
+  StreamMessage m{};
+  m.sequence = 77;
+  m.levels = {1, 2, 3, 4, 0, 0};
+  std::array<CanFrame, can::kMaxStreamFrames> frames{};
+  std::size_t count = 0;
+  REQUIRE(can::encode_stream(m, 3, true, frames, count, kBase) == Error::ok);
+  can::StreamAssembler at_base(3, kBase), plain(3), other_base(3, kBase + 0x800);
+  bool complete = false, plain_complete = false, other_complete = false;
+  for (std::size_t k = 0; k < count; ++k) {
+    CHECK((frames[k].flags & CanFrame::kExtended) != 0);
+    CHECK(frames[k].id >= 0x800);  // never an 11-bit id
+    can::Function f{};
+    std::uint8_t node = 0;
+    REQUIRE(can::split_frame(frames[k], kBase, f, node));
+    CHECK(node == 3);
+    CHECK_FALSE(can::split_frame(frames[k], 0, f, node));
+    REQUIRE(at_base.push(frames[k], complete) == Error::ok);
+    REQUIRE(plain.push(frames[k], plain_complete) == Error::ok);
+    REQUIRE(other_base.push(frames[k], other_complete) == Error::ok);
+  }
+  CHECK(complete);
+  CHECK(at_base.message().sequence == 77);
+  CHECK_FALSE(plain_complete);  // a host on the 11-bit plan ignores them
+  CHECK_FALSE(other_complete);
+
+  const std::vector<std::uint8_t> msg{1, 2, 3, 4, 5, 6, 7, 8, 9, 10};
+  std::array<CanFrame, can::kMaxSegments> segs{};
+  REQUIRE(can::segment(msg, can::Function::request, 3, segs, count, kBase) == Error::ok);
+  can::Reassembler r(can::Function::request, 3, kBase), r0(can::Function::request, 3);
+  bool done = false, done0 = false;
+  for (std::size_t k = 0; k < count; ++k) {
+    REQUIRE(r.push(segs[k], done) == Error::ok);
+    REQUIRE(r0.push(segs[k], done0) == Error::ok);
+  }
+  CHECK(done);
+  CHECK_FALSE(done0);
+  CHECK(std::vector<std::uint8_t>(r.message().begin(), r.message().end()) == msg);
+  const CanFrame hb = can::encode_heartbeat(can::Heartbeat{}, 3, kBase);
+  can::Heartbeat out{};
+  CHECK(can::decode_heartbeat(hb, out, kBase) == Error::ok);
+  CHECK(can::decode_heartbeat(hb, out) == Error::bad_type);
+  CHECK(can::encode_stream(m, 3, true, frames, count, kBase + 1) == Error::bad_value);
+
+  DeviceConfig cfg{};
+  cfg.can_id_base = kBase;
+  CHECK(check_config(cfg, 4) == ConfigField::none);
+  cfg.can_id_base = kBase + 0x10;
+  CHECK(check_config(cfg, 4) == ConfigField::can_id_base);
+}

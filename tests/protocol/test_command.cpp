@@ -1,5 +1,6 @@
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <array>
 
 #include "support/mutate.hpp"
@@ -56,10 +57,57 @@ DeviceInfo sample_info() {
   info.hardware_revision = 4;
   info.pair_group = {0, 1, 2, 3, kPairUnused, kPairUnused, kPairUnused, kPairUnused};
   info.transports = transport_bit::usb_hid | transport_bit::can;
+  info.protocol_minor = kProtocolMinor;
+  info.features = feature_bit::fault_log;
+  info.build_id = 0xCAFEF00D;
+  info.boot_count = 123456;
+  info.reset_cause = ResetCause::watchdog;
   return info;
 }
 
 }  // namespace
+
+TEST_CASE("minor 1 additions: a minor-0 DeviceInfo still reads; the fault log round-trips and is checked") {
+  // A version 1.0 band answers with the 29-byte DeviceInfo: the appended fields read as zero.
+  const DeviceInfo full = sample_info();
+  std::array<std::uint8_t, DeviceInfo::kWireSize> bytes{};
+  ByteWriter w(bytes);
+  full.write(w);
+  REQUIRE(w.size() == DeviceInfo::kWireSize);
+  Response old{};
+  old.opcode = Opcode::get_device_info;
+  old.length = static_cast<std::uint8_t>(DeviceInfo::kMinWireSize);
+  std::copy_n(bytes.begin(), DeviceInfo::kMinWireSize, old.payload.begin());
+  DeviceInfo read{};
+  REQUIRE(read_payload(old, read) == Error::ok);
+  CHECK(read.serial == full.serial);
+  CHECK(read.protocol_minor == 0);
+  CHECK(read.boot_count == 0);
+  CHECK(read.reset_cause == ResetCause::unknown);
+  old.length = static_cast<std::uint8_t>(DeviceInfo::kMinWireSize - 1);
+  CHECK(read_payload(old, read) == Error::bad_length);
+
+  FaultLog log{};
+  log.count = 2;
+  log.more = 1;
+  log.dropped = 3;
+  log.entries[0] = LogEntry{1000, FaultCode::sampler_restarted, 0, 1};
+  log.entries[1] = LogEntry{1200, FaultCode::blocks_lost, 4, 12};
+  check_response_round_trip(Opcode::get_log, Status::ok, log);
+  Response rsp{};
+  REQUIRE(make_response(make_request(Opcode::get_log, 1), Status::ok, log, rsp) == Error::ok);
+  FaultLog bad{};
+  rsp.payload[4 + 4] = 0;  // entry 0 with code none
+  CHECK(read_payload(rsp, bad) == Error::bad_value);
+  rsp.payload[4 + 4] = 1;
+  rsp.payload[0] = 7;  // more entries than fit
+  CHECK(read_payload(rsp, bad) == Error::bad_value);
+  rsp.payload[0] = 2;
+  rsp.payload[4 + 2 * 8] = 5;  // an unused slot that is not zero
+  CHECK(read_payload(rsp, bad) == Error::bad_value);
+  CHECK(is_known(Opcode::get_log));
+  CHECK(is_known(Opcode::enter_bootloader));
+}
 
 TEST_CASE("every request payload round-trips") {
   check_request_round_trip(Opcode::time_sync, TimeSyncRequest{0xFEDCBA9876543210ULL});

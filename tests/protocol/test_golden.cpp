@@ -31,6 +31,7 @@ StreamMessage golden_stream() {
   m.artifact = 0x0000;
   m.group_count = 4;
   m.channel_count = 8;
+  m.boot_epoch = 0x2A;
   m.levels = {0x0000, 0x4000, 0x8000, 0xFFFF, 0, 0};
   for (std::size_t c = 0; c < 8; ++c) m.envelopes[c] = static_cast<std::uint16_t>(0x0100 * (c + 1));
   return m;
@@ -45,6 +46,11 @@ DeviceInfo golden_info() {
   info.hardware_revision = 4;
   info.pair_group = {0, 1, 2, 3, kPairUnused, kPairUnused, kPairUnused, kPairUnused};
   info.transports = transport_bit::usb_hid | transport_bit::can;
+  info.protocol_minor = 1;
+  info.features = feature_bit::boot_epoch | feature_bit::fault_log | feature_bit::bootloader;
+  info.build_id = 0x1a2b3c4d;
+  info.boot_count = 17;
+  info.reset_cause = ResetCause::software;
   return info;
 }
 

@@ -95,3 +95,80 @@ TEST_CASE("device timestamps unwrap across the 32-bit wrap and tolerate small st
   }
   CHECK(u.latest() > 3 * 0x100000000LL);
 }
+
+namespace {
+
+// Pushes `n` reports numbered from `start`, all of one boot; returns how many the tracker took as new.
+std::uint64_t push_run(SequenceTracker& t, std::uint32_t start, std::uint32_t n, std::uint8_t epoch) {
+  std::uint64_t taken = 0;
+  for (std::uint32_t i = start; i < start + n; ++i) {
+    const V v = t.push(static_cast<std::uint16_t>(i), epoch);
+    if (v == V::first || v == V::in_order || v == V::gap || v == V::resync) ++taken;
+  }
+  return taken;
+}
+
+}  // namespace
+
+TEST_CASE("a reboot within 4096 reports, told by the boot epoch, drops nothing (issue 10, defect 8)") {
+  // The band reboots after n reports and numbers from 0 again. Without the epoch the
+  // restarted numbers look older than the newest one and were dropped as stale or duplicates.
+  for (const std::uint32_t n : {1U, 2U, 63U, 64U, 65U, 2000U, 4095U}) {
+    CAPTURE(n);
+    SequenceTracker t;
+    CHECK(push_run(t, 0, n, 17) == n);
+    CHECK(push_run(t, 0, 3000, 18) == 3000);  // the second boot
+    CHECK(t.received() == n + 3000);
+    CHECK(t.resyncs() == 1);
+    CHECK(t.lost() == 0);
+    CHECK(t.stale() == 0);
+    CHECK(t.duplicates() == 0);
+    CHECK(t.reordered() == 0);
+  }
+}
+
+TEST_CASE("boot epoch: a reboot that restarts mid-number, and epochs that wrap") {
+  SequenceTracker t;
+  CHECK(push_run(t, 100, 50, 255) == 50);
+  CHECK(push_run(t, 120, 10, 1) == 10);  // 255 -> 1: any change is a new boot, even to a lower value
+  CHECK(t.push(130, 1) == V::in_order);
+  CHECK(t.push(130, 1) == V::duplicate);  // within one boot the history still works
+  CHECK(t.resyncs() == 1);
+  CHECK(t.lost() == 0);
+}
+
+TEST_CASE("boot epoch 0 (an older device) keeps the version-1.0 bookkeeping") {
+  SequenceTracker t;
+  CHECK(push_run(t, 0, 2000, 0) == 2000);
+  // Without an epoch a restart at 0 cannot be told from very late reports.
+  CHECK(t.push(0, 0) == V::stale);
+  CHECK(t.resyncs() == 0);
+}
+
+TEST_CASE("after a reconnect, a backward jump is taken as a restart, a forward one as loss") {
+  SequenceTracker t;
+  push_run(t, 0, 2000, 0);
+  t.note_reconnect();
+  CHECK(t.push(0, 0) == V::resync);  // the link was reopened: the band most likely rebooted
+  CHECK(t.push(1, 0) == V::in_order);
+  CHECK(t.resyncs() == 1);
+  t.note_reconnect();
+  CHECK(t.push(11, 0) == V::gap);  // the same boot went on while the link was down
+  CHECK(t.lost() == 9);
+  CHECK(t.resyncs() == 1);
+  // Only the first report after the reconnect gets the benefit.
+  CHECK(t.push(5, 0) == V::late);
+}
+
+TEST_CASE("a restart known out of band (CAN heartbeat) counts once and loses nothing") {
+  SequenceTracker t;
+  t.note_restart();  // before any report: nothing to restart
+  CHECK(t.resyncs() == 0);
+  push_run(t, 0, 1000, 0);
+  t.note_restart();
+  CHECK(t.push(0, 0) == V::first);
+  CHECK(push_run(t, 1, 999, 0) == 999);
+  CHECK(t.resyncs() == 1);
+  CHECK(t.lost() == 0);
+  CHECK(t.stale() + t.duplicates() == 0);
+}

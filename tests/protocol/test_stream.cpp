@@ -111,16 +111,32 @@ TEST_CASE("stream decoder: every single-byte corruption is an error or a self-co
       return;
     }
     ++valid;
-    // A message that decodes must re-encode to the same bytes (the reserved
-    // byte is the one field a decoder ignores).
+    // A message that decodes must re-encode to the same bytes (byte 3, once
+    // reserved, is the boot epoch: every byte is a field now).
     std::array<std::uint8_t, kMaxMessageSize> again{};
     std::size_t m2 = 0;
     REQUIRE(encode_stream(out, again, m2) == Error::ok);
     REQUIRE(m2 <= bytes.size());
     for (std::size_t i = 0; i < m2; ++i) {
-      if (i != 3) CHECK(again[i] == bytes[i]);
+      CHECK(again[i] == bytes[i]);
     }
   });
   CHECK(errors > 0);
   CHECK(valid > 0);
+}
+
+TEST_CASE("boot epoch rides in byte 3, and a version-1.0 report (byte 3 = 0) decodes as unknown") {
+  StreamMessage m{};
+  m.boot_epoch = 0xA5;
+  std::array<std::uint8_t, kMaxMessageSize> buf{};
+  std::size_t n = 0;
+  REQUIRE(encode_stream(m, buf, n) == Error::ok);
+  CHECK(buf[3] == 0xA5);
+  StreamMessage back{};
+  REQUIRE(decode_stream(std::span(buf).first(n), back) == Error::ok);
+  CHECK(back.boot_epoch == 0xA5);
+  CHECK(back == m);
+  buf[3] = 0;
+  REQUIRE(decode_stream(std::span(buf).first(n), back) == Error::ok);
+  CHECK(back.boot_epoch == kBootEpochUnknown);
 }

@@ -61,20 +61,24 @@ Biquad design_highpass(double fs_hz, double fc_hz, double q) {
 Biquad design_notch(double fs_hz, double f0_hz, double bandwidth_hz) {
   const double w0 = omega(f0_hz, fs_hz);
   const double cw = std::cos(w0);
-  const double alpha = std::sin(w0) / (2.0 * (f0_hz / bandwidth_hz));
+  // alpha = tan(pi B / fs) puts the digital -3 dB points exactly B apart
+  // (Orfanidis, Introduction to Signal Processing, 11.3). The cookbook's
+  // sin(w0) / 2Q is B only near DC: 2.6-3.9 Hz for the harmonics at 1 kHz.
+  const double alpha = std::tan(std::numbers::pi * bandwidth_hz / fs_hz);
   return normalise({1.0, -2.0 * cw, 1.0, 1.0 + alpha, -2.0 * cw, 1.0 - alpha});
 }
 
 double magnitude(const Biquad& c, double f_hz, double fs_hz) {
   const double w = omega(f_hz, fs_hz);
-  const Complex num = poly(c.b0, c.b1, c.b2, w);
-  const Complex den = poly(1.0, c.a1, c.a2, w);
+  const Complex num = poly(static_cast<double>(c.b0), static_cast<double>(c.b1), static_cast<double>(c.b2), w);
+  const Complex den = poly(1.0, static_cast<double>(c.a1), static_cast<double>(c.a2), w);
   return std::sqrt((num.re * num.re + num.im * num.im) / (den.re * den.re + den.im * den.im));
 }
 
 double group_delay_samples(const Biquad& c, double f_hz, double fs_hz) {
   const double w = omega(f_hz, fs_hz);
-  return poly_delay(c.b0, c.b1, c.b2, w) - poly_delay(1.0, c.a1, c.a2, w);
+  return poly_delay(static_cast<double>(c.b0), static_cast<double>(c.b1), static_cast<double>(c.b2), w) -
+         poly_delay(1.0, static_cast<double>(c.a1), static_cast<double>(c.a2), w);
 }
 
 }  // namespace tonus::fw

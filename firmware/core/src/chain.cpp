@@ -50,6 +50,7 @@ ChainModel design_chain(const proto::DeviceConfig& cfg) {
   m.rms_slot_samples = (safe_window + slots - 1) / slots;
   m.rms_slots = (safe_window + m.rms_slot_samples - 1) / m.rms_slot_samples;
   if (m.rms_slots > slots) m.rms_slots = slots;
+  m.level = design_level_envelope(cfg);
   return m;
 }
 
@@ -72,8 +73,9 @@ float chain_step(const ChainModel& m, ChannelState& s, float x, ChainTaps& taps)
   for (std::size_t k = 0; k < m.lowpass_sections; ++k) y = biquad_step(m.lowpass[k], s.lowpass[k], y);
   taps.emg = y;
 
+  const float rectified = std::fabs(y);
+  level_envelope_step(m.level, s.level, rectified);
   if (m.envelope_mode == proto::EnvelopeMode::linear) {
-    const float rectified = std::fabs(y);
     s.envelope += m.envelope_alpha * (rectified - s.envelope);
     return s.envelope;
   }
@@ -94,7 +96,7 @@ float chain_step(const ChainModel& m, ChannelState& s, float x, ChainTaps& taps)
 }
 
 ChainDelay chain_group_delay(const ChainModel& m, double at_hz) {
-  const double fs = m.sample_rate_hz;
+  const double fs = static_cast<double>(m.sample_rate_hz);
   double samples = 0.0;
   for (std::size_t k = 0; k < m.highpass_sections; ++k) samples += group_delay_samples(m.highpass[k], at_hz, fs);
   for (std::size_t k = 0; k < m.notch_count; ++k) samples += group_delay_samples(m.notch[k], at_hz, fs);
@@ -103,7 +105,7 @@ ChainDelay chain_group_delay(const ChainModel& m, double at_hz) {
   d.filters_s = samples / fs;
   if (m.envelope_mode == proto::EnvelopeMode::linear) {
     // y += a (x - y): H = a / (1 - (1-a) z^-1), group delay at DC = (1 - a) / a samples.
-    const double a = m.envelope_alpha;
+    const double a = static_cast<double>(m.envelope_alpha);
     d.envelope_s = (1.0 - a) / a / fs;
   } else {
     // Moving average of N samples delays by (N - 1) / 2, plus half a slot of hold on average.
@@ -114,7 +116,7 @@ ChainDelay chain_group_delay(const ChainModel& m, double at_hz) {
 }
 
 double chain_magnitude(const ChainModel& m, double f_hz) {
-  const double fs = m.sample_rate_hz;
+  const double fs = static_cast<double>(m.sample_rate_hz);
   double g = 1.0;
   for (std::size_t k = 0; k < m.highpass_sections; ++k) g *= magnitude(m.highpass[k], f_hz, fs);
   for (std::size_t k = 0; k < m.notch_count; ++k) g *= magnitude(m.notch[k], f_hz, fs);

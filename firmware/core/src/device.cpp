@@ -5,9 +5,16 @@
 #include "tonus/protocol/hid.hpp"
 #include "tonus/protocol/wire.hpp"
 
+// The commit the firmware was built from (firmware/CMakeLists.txt), 0 if unknown.
+#ifndef TONUS_BUILD_ID
+#define TONUS_BUILD_ID 0
+#endif
+
 namespace tonus::fw {
 
 namespace {
+
+constexpr std::uint32_t kBuildId = static_cast<std::uint32_t>(TONUS_BUILD_ID);
 
 using proto::Status;
 
@@ -77,17 +84,39 @@ void Device::boot() {
   block_lost_pending_ = false;
   stale_blocks_ = 0;
   reset_pending_ = false;
+  reset_issued_ = false;
+  reset_deadline_us_ = 0;
+  to_bootloader_ = false;
+  reset_cause_ = board_.system.reset_cause();
+  faults_ = FaultLog{};
   calibrator_ = Calibrator{};
 
   Persisted p{default_config(front_end_), default_calibration(front_end_)};
   Persisted stored{};
   load_result_ = load_persisted(board_.storage, stored);
+  boot_count_ = 0;
   if (load_result_ == LoadResult::loaded) {
     // A record from a board with another front end (or a bug) must not brick the band.
-    if (check_device_config(stored.config, front_end_) == proto::ConfigField::none) {
+    const proto::ConfigField bad = check_device_config(stored.config, front_end_);
+    if (bad == proto::ConfigField::none) {
       p = stored;
     } else {
       load_result_ = LoadResult::corrupt;
+      fault(proto::FaultCode::config_rejected, static_cast<std::uint16_t>(bad));
+    }
+  } else if (load_result_ != LoadResult::empty) {
+    fault(proto::FaultCode::storage_corrupt, static_cast<std::uint16_t>(load_result_));
+  }
+  if (watchdog_reset_) fault(proto::FaultCode::watchdog_reset, 0);
+  // The boot count rides in the record: counted where the storage holds this
+  // firmware's record or nothing. Anything else is left as found (a newer
+  // firmware's record after a downgrade, a corrupt one to look at).
+  if (load_result_ == LoadResult::loaded || load_result_ == LoadResult::empty) {
+    p.boot_count = (load_result_ == LoadResult::loaded ? stored.boot_count : 0U) + 1U;
+    if (save_persisted(board_.storage, p)) {
+      boot_count_ = p.boot_count;
+    } else {
+      fault(proto::FaultCode::storage_error, 0);
     }
   }
   calibration_ = p.calibration;
@@ -108,7 +137,7 @@ void Device::apply_config(const proto::DeviceConfig& cfg, bool restart_sampler) 
   level_state_ = LevelState{};
   envelopes_.fill(0.0F);
   report_phase_ = 0;
-  can_requests_ = proto::can::Reassembler(proto::can::Function::request, cfg.can_node_id);
+  can_requests_ = proto::can::Reassembler(proto::can::Function::request, cfg.can_node_id, cfg.can_id_base);
   if (restart_sampler || rate_changed) {
     sampler_ok_ = board_.emg.start(cfg.sample_rate_hz);
     block_seen_ = false;  // a restarted sampler may restart its sequence
@@ -143,6 +172,13 @@ proto::DeviceStats Device::stats() const {
 
 void Device::poll() {
   const std::uint64_t now = board_.clock.now_us();
+  if (board_.hid != nullptr) board_.hid->service();
+  if (reset_pending_) {
+    // Nothing new is taken in or sent while the answer to `reset` drains.
+    reboot_when_drained(now);
+    board_.watchdog.kick();
+    return;
+  }
   poll_hid();
   poll_can();
   while (const hal::SampleBlock* block = board_.emg.acquire()) {
@@ -165,9 +201,22 @@ void Device::check_sampler(std::uint64_t now_us) {
     sampler_ok_ = board_.emg.start(config_.sample_rate_hz);
     block_seen_ = false;
     sampler_since_us_ = now_us;
+    fault(proto::FaultCode::sampler_restarted, stall_restarts_);
     return;
   }
   sampler_stalled_ = true;
+  fault(proto::FaultCode::sampler_stalled, 0);
+}
+
+std::uint8_t Device::boot_epoch() const {
+  // The board's own epoch, else one from the persisted boot count.
+  const std::uint8_t board = board_.system.boot_epoch();
+  if (board != 0 || boot_count_ == 0) return board;
+  return static_cast<std::uint8_t>(boot_count_ % 255U + 1U);
+}
+
+void Device::fault(proto::FaultCode code, std::uint16_t arg) {
+  faults_.record(code, arg, static_cast<std::uint32_t>(board_.clock.now_us() / 1000U));
 }
 
 void Device::process_block(const hal::SampleBlock& block, std::uint64_t now_us) {
@@ -184,6 +233,7 @@ void Device::process_block(const hal::SampleBlock& block, std::uint64_t now_us) 
     if (ahead > 0) {
       stats_.lost_blocks += static_cast<std::uint32_t>(ahead);
       block_lost_pending_ = true;
+      fault(proto::FaultCode::blocks_lost, static_cast<std::uint16_t>(ahead < 0xFFFF ? ahead : 0xFFFF));
     }
   }
   block_seen_ = true;
@@ -232,6 +282,7 @@ void Device::emit_report(std::uint64_t t_us) {
   m.device_time_us = static_cast<std::uint32_t>(t_us);
   m.group_count = static_cast<std::uint8_t>(kGroups);
   m.channel_count = static_cast<std::uint8_t>(kChannels);
+  m.boot_epoch = boot_epoch();
 
   std::array<float, kPairs> c{};
   for (std::size_t ch = 0; ch < kChannels; ++ch) {
@@ -245,9 +296,12 @@ void Device::emit_report(std::uint64_t t_us) {
   for (std::size_t p = 0; p < kPairs; ++p) {
     const bool off = (m.electrode_off & (bit(2 * p) | bit(2 * p + 1))) != 0;
     // A lifted electrode reads hum, not effort: its pair relaxes instead of stiffening.
+    // Levels use the level envelope: fast after a change of effort (level_envelope.hpp).
+    const float flexor = level_envelope(chain_, channels_[2 * p]);
+    const float extensor = level_envelope(chain_, channels_[2 * p + 1]);
     c[p] = off ? 0.0F
-               : cocontraction(config_.measure, normalise(calibration_, 2 * p, envelopes_[2 * p]),
-                               normalise(calibration_, 2 * p + 1, envelopes_[2 * p + 1])) /
+               : cocontraction(config_.measure, normalise(calibration_, 2 * p, flexor),
+                               normalise(calibration_, 2 * p + 1, extensor)) /
                      calibration_.cocontraction[p];
   }
   std::array<std::uint16_t, kGroups> groups{};
@@ -267,12 +321,14 @@ void Device::emit_report(std::uint64_t t_us) {
     const bool with_env = config_.can_envelope_divider != 0 && m.sequence % config_.can_envelope_divider == 0;
     std::array<proto::CanFrame, proto::can::kMaxStreamFrames> frames{};
     std::size_t count = 0;
-    if (proto::can::encode_stream(m, config_.can_node_id, with_env, frames, count) != proto::Error::ok) {
+    if (proto::can::encode_stream(m, config_.can_node_id, with_env, frames, count, config_.can_id_base) !=
+        proto::Error::ok) {
       ++stats_.tx_dropped;
     } else {
       for (std::size_t k = 0; k < count; ++k) {
         if (!board_.can->send(frames[k])) {
           ++stats_.tx_dropped;  // the rest of the cycle would be incomplete anyway
+          fault(proto::FaultCode::can_down, static_cast<std::uint16_t>(count - k));
           break;
         }
       }
@@ -315,8 +371,9 @@ void Device::receive(std::span<const std::uint8_t> message, Link link, std::uint
   const proto::Error e = proto::decode_request(message, req);
   proto::Response rsp{};
   // The answer leaves from the id the request was sent to, even when the
-  // request changes it (set_config of can_node_id): the host waits there.
+  // request changes it (set_config of can_node_id or can_id_base): the host waits there.
   const std::uint8_t answer_node = config_.can_node_id;
+  const std::uint32_t answer_base = config_.can_id_base;
   if (e == proto::Error::ok) {
     handle(req, rx_us, rsp);
   } else {
@@ -332,11 +389,11 @@ void Device::receive(std::span<const std::uint8_t> message, Link link, std::uint
     if (e == proto::Error::bad_version) s = Status::bad_version;
     rsp = proto::make_response(header, s);
   }
-  reply(rsp, link, answer_node);
+  reply(rsp, link, answer_node, answer_base);
   after_reply(link);
 }
 
-void Device::reply(const proto::Response& rsp, Link link, std::uint8_t can_node) {
+void Device::reply(const proto::Response& rsp, Link link, std::uint8_t can_node, std::uint32_t can_id_base) {
   if (link == Link::hid) {
     proto::hid::Report r{};
     if (proto::hid::pack_response(rsp, r) != proto::Error::ok || !board_.hid->send_input(r)) ++stats_.tx_dropped;
@@ -348,7 +405,7 @@ void Device::reply(const proto::Response& rsp, Link link, std::uint8_t can_node)
   std::size_t count = 0;
   if (proto::encode_response(rsp, bytes, n) != proto::Error::ok ||
       proto::can::segment(std::span<const std::uint8_t>(bytes).first(n), proto::can::Function::response, can_node,
-                          frames, count) != proto::Error::ok) {
+                          frames, count, can_id_base) != proto::Error::ok) {
     ++stats_.tx_dropped;
     return;
   }
@@ -361,7 +418,23 @@ void Device::reply(const proto::Response& rsp, Link link, std::uint8_t can_node)
 }
 
 void Device::after_reply(Link) {
-  if (!reset_pending_) return;
+  if (!reset_pending_ || reset_deadline_us_ != 0) return;
+  reset_deadline_us_ = board_.clock.now_us() + kResetDrainUs;
+  reboot_when_drained(board_.clock.now_us());
+}
+
+void Device::reboot_when_drained(std::uint64_t now_us) {
+  if (reset_issued_) return;
+  // The answer to `reset` must leave first: over HID it waits for the host's
+  // next IN poll, over CAN for the transmit queue (a reset cuts both short).
+  const bool hid_done = board_.hid == nullptr || !board_.hid->connected() || board_.hid->idle();
+  const bool can_done = board_.can == nullptr || board_.can->idle();
+  if (!(hid_done && can_done) && now_us < reset_deadline_us_) return;
+  reset_issued_ = true;
+  if (to_bootloader_) {
+    board_.system.enter_bootloader();
+    return;
+  }
   if (reset_kind_ == proto::ResetKind::factory_defaults) erase_persisted(board_.storage);
   board_.system.reset();
 }
@@ -384,6 +457,12 @@ void Device::handle(const proto::Request& req, std::uint64_t rx_us, proto::Respo
       info.pair_group = config_.pair_group;
       info.transports = static_cast<std::uint8_t>((board_.hid != nullptr ? proto::transport_bit::usb_hid : 0) |
                                                   (board_.can != nullptr ? proto::transport_bit::can : 0));
+      info.protocol_minor = proto::kProtocolMinor;
+      info.features = proto::feature_bit::fault_log | (boot_epoch() != 0 ? proto::feature_bit::boot_epoch : 0U) |
+                      (board_.system.has_bootloader() ? proto::feature_bit::bootloader : 0U);
+      info.build_id = kBuildId;
+      info.boot_count = boot_count_;
+      info.reset_cause = reset_cause_;
       proto::make_response(req, Status::ok, info, rsp);
       return;
     }
@@ -403,6 +482,22 @@ void Device::handle(const proto::Request& req, std::uint64_t rx_us, proto::Respo
       return;
     }
     case Opcode::get_stats: proto::make_response(req, Status::ok, stats(), rsp); return;
+    case Opcode::get_log: {
+      proto::FaultLog log{};
+      faults_.take(log);
+      proto::make_response(req, Status::ok, log, rsp);
+      return;
+    }
+    case Opcode::enter_bootloader:
+      if (!board_.system.has_bootloader()) {
+        ++stats_.commands_rejected;
+        rsp = proto::make_response(req, Status::wrong_state);
+        return;
+      }
+      reset_pending_ = true;
+      to_bootloader_ = true;
+      rsp = proto::make_response(req, Status::ok);
+      return;
     case Opcode::calibration_start: on_calibration_start(req, rsp, rx_us); return;
     case Opcode::calibration_abort: {
       const Status s = calibrator_.abort();
@@ -421,8 +516,9 @@ void Device::handle(const proto::Request& req, std::uint64_t rx_us, proto::Respo
         rsp = proto::make_response(req, Status::wrong_state);
         return;
       }
-      const bool ok = save_persisted(board_.storage, Persisted{config_, calibration_});
+      const bool ok = save_persisted(board_.storage, Persisted{config_, calibration_, boot_count_});
       if (ok) config_dirty_ = false;
+      if (!ok) fault(proto::FaultCode::storage_error, 0);
       rsp = proto::make_response(req, ok ? Status::ok : Status::storage_error);
       return;
     }
@@ -492,7 +588,9 @@ void Device::send_heartbeat(std::uint64_t now_us) {
                                               : proto::can::NodeState::running;
   hb.status = status_bits();
   hb.uptime_ms = static_cast<std::uint32_t>((now_us - boot_us_) / 1000U);
-  if (!board_.can->send(proto::can::encode_heartbeat(hb, config_.can_node_id))) ++stats_.tx_dropped;
+  if (!board_.can->send(proto::can::encode_heartbeat(hb, config_.can_node_id, config_.can_id_base))) {
+    ++stats_.tx_dropped;
+  }
 }
 
 void Device::update_led() {

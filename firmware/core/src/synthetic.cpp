@@ -32,13 +32,14 @@ const char* to_string(Scenario s) {
     case Scenario::hum: return "hum";
     case Scenario::dropout: return "dropout";
     case Scenario::selftest: return "selftest";
+    case Scenario::step: return "step";
   }
   return "unknown";
 }
 
 bool parse_scenario(const char* name, Scenario& out) {
   for (auto s : {Scenario::rest, Scenario::ramp, Scenario::faults, Scenario::bursts, Scenario::hum, Scenario::dropout,
-                 Scenario::selftest}) {
+                 Scenario::selftest, Scenario::step}) {
     if (equal(name, to_string(s))) {
       out = s;
       return true;
@@ -75,7 +76,7 @@ float sin_turns(float turns) {
 
 SyntheticEmg::SyntheticEmg(const SynthSpec& spec) : spec_(spec), rng_(spec.seed) {
   total_ = static_cast<std::size_t>(spec.seconds * spec.sample_rate_hz);
-  const double fs = spec.sample_rate_hz;
+  const double fs = static_cast<double>(spec.sample_rate_hz);
   const double lp = 200.0 < 0.4 * fs ? 200.0 : 0.4 * fs;
   shape_hp_ = design_highpass(fs, 40.0 < 0.2 * fs ? 40.0 : 0.2 * fs, 0.7071);
   shape_lp_ = design_lowpass(fs, lp, 0.7071);
@@ -119,6 +120,11 @@ float SyntheticEmg::activation(std::size_t ch, float t) const {
       if (t < 0.3F * T) return 0.0F;
       if (t < 0.65F * T) return ch < 4 ? 0.5F : 0.05F;
       return (ch >= 4 && ch % 2 == 0) ? 0.7F : 0.05F;
+    }
+    case Scenario::step: {
+      // Same expression as the frame times of generate(): the step lands exactly on step_frame.
+      const float t_step = static_cast<float>(step_frame(spec_)) / spec_.sample_rate_hz;
+      return t >= t_step ? spec_.step_activation : spec_.step_from;
     }
   }
   return 0.0F;

@@ -35,30 +35,59 @@ class AdcDmaSampler final : public hal::EmgSampler {
   std::uint16_t rate_hz_ = 0;
 };
 
+// Exact bxCAN bit timing (BTR without mode bits) for `bitrate` from the APB1
+// clock `pclk_hz`; false if no split of 8..25 quanta divides it exactly.
+bool can_bit_timing(std::uint32_t pclk_hz, std::uint32_t bitrate, std::uint32_t& btr);
+
+enum class CanFault : std::uint8_t {
+  none,
+  no_crystal,  // on the internal oscillator: too inexact for CAN, stays off the bus
+  no_timing,   // no exact bit timing from this clock
+  no_bus,      // init mode never left (no bus or transceiver): retried every second
+};
+
 class BxCan final : public hal::CanPort {
  public:
-  // Initialises CAN1; false if the controller does not leave init mode (no transceiver/bus).
+  static constexpr std::uint32_t kBitrate = 1000000;
+  static constexpr std::uint64_t kRetryUs = 1000000;
+  // Initialises CAN1 with the bit timing of the clock actually running. False
+  // with fault() set if it cannot join the bus; no_bus is retried from send()
+  // and receive() every kRetryUs.
   bool init(std::uint8_t node);
   bool send(const proto::CanFrame& frame) override;
   bool receive(proto::CanFrame& frame) override;
   void on_tx_irq();
   void on_rx_irq();
   // Every queued frame has left the mailboxes.
-  [[nodiscard]] bool idle() const;
+  [[nodiscard]] bool idle() const override;
+  [[nodiscard]] CanFault fault() const { return fault_; }
+  [[nodiscard]] bool up() const { return up_; }
+  [[nodiscard]] std::uint32_t init_retries() const { return init_retries_; }
 
  private:
   void fill_mailboxes();
+  bool retry_later();
+  bool ensure_up();
   static constexpr std::size_t kTxRing = 64, kRxRing = 32;
   std::array<proto::CanFrame, kTxRing> tx_{};
   std::array<proto::CanFrame, kRxRing> rx_{};
   volatile std::size_t tx_head_ = 0, tx_tail_ = 0, rx_head_ = 0, rx_tail_ = 0;
+  std::uint8_t node_ = 1;
+  bool up_ = false;
+  CanFault fault_ = CanFault::no_bus;
+  std::uint64_t next_retry_us_ = 0;
+  std::uint32_t init_retries_ = 0;
 };
 
+// Flash sectors 1 and 2 (16 KiB each at 0x08004000, the linker's NVM region).
 class FlashStorage final : public hal::Storage {
  public:
-  [[nodiscard]] std::size_t size() const override;
+  static constexpr std::size_t kSectorSize = std::size_t{16} * 1024;
+  static constexpr std::size_t kFirstSector = 1;
+  [[nodiscard]] std::size_t sector_size() const override { return kSectorSize; }
+  [[nodiscard]] std::size_t sector_count() const override;
   bool read(std::size_t offset, std::span<std::uint8_t> out) override;
-  bool erase() override;
+  bool erase(std::size_t sector) override;
   bool program(std::size_t offset, std::span<const std::uint8_t> data) override;
 };
 
@@ -88,11 +117,22 @@ class Iwdg final : public hal::Watchdog {
 
 class NvicReset final : public hal::SystemControl {
  public:
-  explicit NvicReset(const BxCan* can) : can_(can) {}
-  void reset() override;  // lets the CAN queue drain (<= 20 ms), then SYSRESETREQ
+  // SYSRESETREQ at once: fw::Device calls it only once its links have drained
+  // (the reply to `reset` has left) or their deadline has passed.
+  void reset() override;
+  // A boot counter in RTC backup register 0 (kept across resets), read and
+  // bumped once per boot; 1..255, never 0.
+  [[nodiscard]] std::uint8_t boot_epoch() const override;
+  // From RCC_CSR's reset flags, latched before Iwdg::init clears them.
+  void latch_reset_cause();
+  [[nodiscard]] proto::ResetCause reset_cause() const override { return cause_; }
+  // The ROM's USB DFU bootloader (bootloader.hpp).
+  [[nodiscard]] bool has_bootloader() const override { return true; }
+  void enter_bootloader() override;
 
  private:
-  const BxCan* can_;
+  mutable std::uint8_t epoch_ = 0;
+  proto::ResetCause cause_ = proto::ResetCause::unknown;
 };
 
 }  // namespace tonus::f405

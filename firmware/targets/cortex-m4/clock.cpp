@@ -1,5 +1,7 @@
 #include "clock.hpp"
 
+#include <atomic>
+
 #include "registers.hpp"
 
 namespace tonus::f405 {
@@ -7,9 +9,13 @@ namespace tonus::f405 {
 namespace {
 
 ClockState g_clocks;
-volatile std::uint32_t g_ms = 0;  // 32 bits: one atomic load on the M4
-std::uint32_t g_last_ms = 0;      // main-loop side extension to 64 bits
-std::uint64_t g_high = 0;
+
+// The millisecond count, extended to 64 bits by its only writer, the SysTick
+// interrupt, under a sequence counter (odd while it writes). micros() only
+// reads, so any context may call it: the main loop and the DMA interrupt do.
+std::atomic<std::uint32_t> g_tick_seq{0};
+std::atomic<std::uint32_t> g_ms_low{0};
+std::atomic<std::uint32_t> g_ms_high{0};
 
 bool wait_set(Reg r, std::uint32_t bits, std::uint32_t spins) {
   while (spins-- != 0) {
@@ -22,6 +28,7 @@ bool wait_set(Reg r, std::uint32_t bits, std::uint32_t spins) {
 
 void clock_init() {
   constexpr std::uint32_t kHseOn = 1U << 16U, kHseRdy = 1U << 17U, kPllOn = 1U << 24U, kPllRdy = 1U << 25U;
+  g_clocks = ClockState{};  // the internal oscillator until the PLL runs
   rcc::cr.set(kHseOn);
   if (!wait_set(rcc::cr, kHseRdy, 200000)) return;  // no crystal: stay on HSI
   // PLL: M = 8, N = 336, P = 2 (00), Q = 7, source HSE.
@@ -49,20 +56,43 @@ void systick_start() {
 }
 
 std::uint64_t micros() {
-  // Read the count on both sides of the down-counter to catch a wrap in between.
-  // Called from the main loop only, so the 64-bit extension needs no lock.
-  std::uint32_t ms = 0;
-  std::uint32_t val = 0;
+  constexpr std::uint32_t kPendStSet = 1U << 26U;  // ICSR: SysTick interrupt pending
+  std::uint32_t seq = 0, low = 0, high = 0, val = 0, icsr = 0;
   do {
-    ms = g_ms;
+    seq = g_tick_seq.load(std::memory_order_acquire);
+    low = g_ms_low.load(std::memory_order_relaxed);
+    high = g_ms_high.load(std::memory_order_relaxed);
     val = systick::val.read();
-  } while (ms != g_ms);
-  if (ms < g_last_ms) g_high += 1ULL << 32U;  // the 32-bit count wrapped (every 49.7 days)
-  g_last_ms = ms;
+    icsr = scb::icsr.read();
+    std::atomic_thread_fence(std::memory_order_acquire);
+  } while ((seq & 1U) != 0 || seq != g_tick_seq.load(std::memory_order_relaxed));
   const std::uint32_t load = systick::load.read() + 1U;
-  return (g_high + ms) * 1000U + static_cast<std::uint64_t>(load - 1U - val) * 1000U / load;
+  std::uint64_t ms = (static_cast<std::uint64_t>(high) << 32U) | low;
+  // The counter wrapped but its interrupt has not run yet (we are in a
+  // handler of equal or higher priority, or interrupts are masked): count it.
+  // A large VAL means the wrap happened before our read of it.
+  if ((icsr & kPendStSet) != 0 && val > load / 2U) ++ms;
+  return ms * 1000U + static_cast<std::uint64_t>(load - 1U - val) * 1000U / load;
+}
+
+void systick_tick() {
+  // One writer (this interrupt), so plain read-modify-writes suffice.
+  g_tick_seq.store(g_tick_seq.load(std::memory_order_relaxed) + 1U, std::memory_order_relaxed);
+  std::atomic_thread_fence(std::memory_order_release);
+  const std::uint32_t low = g_ms_low.load(std::memory_order_relaxed) + 1U;
+  g_ms_low.store(low, std::memory_order_relaxed);
+  if (low == 0) g_ms_high.store(g_ms_high.load(std::memory_order_relaxed) + 1U, std::memory_order_relaxed);
+  g_tick_seq.store(g_tick_seq.load(std::memory_order_relaxed) + 1U, std::memory_order_release);
+}
+
+void set_tick_count(std::uint64_t ms) {
+  g_tick_seq.store(g_tick_seq.load(std::memory_order_relaxed) + 1U, std::memory_order_relaxed);
+  std::atomic_thread_fence(std::memory_order_release);
+  g_ms_low.store(static_cast<std::uint32_t>(ms), std::memory_order_relaxed);
+  g_ms_high.store(static_cast<std::uint32_t>(ms >> 32U), std::memory_order_relaxed);
+  g_tick_seq.store(g_tick_seq.load(std::memory_order_relaxed) + 1U, std::memory_order_release);
 }
 
 }  // namespace tonus::f405
 
-extern "C" void SysTick_Handler() { tonus::f405::g_ms = tonus::f405::g_ms + 1U; }
+extern "C" void SysTick_Handler() { tonus::f405::systick_tick(); }

@@ -25,8 +25,11 @@ struct ClockState {
 void clock_init();
 const ClockState& clocks();
 
-// SysTick at 1 kHz, extended to a 64-bit microsecond count.
+// SysTick at 1 kHz, extended to a 64-bit microsecond count. micros() is safe
+// from any context (main loop or interrupt): it only reads.
 void systick_start();
 std::uint64_t micros();
+void systick_tick();                    // the SysTick interrupt's work
+void set_tick_count(std::uint64_t ms);  // start-up (and tests): the millisecond count
 
 }  // namespace tonus::f405

@@ -9,7 +9,9 @@ namespace {
 
 // GINTSTS / GINTMSK
 constexpr std::uint32_t kRxFlvl = 1U << 4U, kUsbSusp = 1U << 11U, kUsbRst = 1U << 12U, kEnumDne = 1U << 13U,
-                        kIepInt = 1U << 18U, kOepInt = 1U << 19U;
+                        kIepInt = 1U << 18U, kOepInt = 1U << 19U, kWkupInt = 1U << 31U;
+// PCGCCTL: stop the PHY clock / gate HCLK (cleared on resume)
+constexpr std::uint32_t kStopPclk = 1U << 0U, kGateHclk = 1U << 1U;
 // DIEPCTL / DOEPCTL
 constexpr std::uint32_t kUsbAep = 1U << 15U, kStall = 1U << 21U, kCnak = 1U << 26U, kSnak = 1U << 27U,
                         kSd0Pid = 1U << 28U, kEpEna = 1U << 31U;
@@ -84,7 +86,7 @@ bool OtgFsDcd::init() {
   otg::doepmsk.write(kXfrc | kStup);
   otg::daintmsk.write(0);
   otg::gintsts.write(0xFFFFFFFFU);
-  otg::gintmsk.write(kRxFlvl | kUsbSusp | kUsbRst | kEnumDne | kIepInt | kOepInt);
+  otg::gintmsk.write(kRxFlvl | kUsbSusp | kWkupInt | kUsbRst | kEnumDne | kIepInt | kOepInt);
   otg::gahbcfg.write(1U);  // global interrupt enable
   nvic::priority(kIrqOtgFs, 0x30);
   nvic::enable(kIrqOtgFs);
@@ -134,6 +136,13 @@ void OtgFsDcd::on_irq() {
   if ((sts & kUsbSusp) != 0) {
     otg::gintsts.write(kUsbSusp);
     if (core_ != nullptr) core_->on_suspend();
+  }
+  if ((sts & kWkupInt) != 0) {
+    // Resume signalling from the host: the configuration is kept (USB 2.0
+    // 9.1.1.6), the stream goes on where it was.
+    otg::gintsts.write(kWkupInt);
+    otg::pcgcctl.clear(kStopPclk | kGateHclk);
+    if (core_ != nullptr) core_->on_resume();
   }
   while ((otg::gintsts.read() & kRxFlvl) != 0) receive_packet();
   if ((sts & kOepInt) != 0) out_endpoint_events();
@@ -204,7 +213,7 @@ void OtgFsDcd::set_address(std::uint8_t address) {
 void OtgFsDcd::ep0_in_next() {
   const std::size_t n = ep0_tx_left_ < usb::kEp0Size ? ep0_tx_left_ : usb::kEp0Size;
   if (n == 0) ep0_zlp_ = false;  // this is the zero-length packet
-  otg::dieptsiz(0).write(kOnePacket | n);
+  otg::dieptsiz(0).write(kOnePacket | static_cast<std::uint32_t>(n));
   otg::diepctl(0).set(kEpEna | kCnak);
   write_fifo(0, ep0_tx_, n);
   ep0_tx_ += n;
@@ -222,7 +231,7 @@ void OtgFsDcd::ep0_send(std::span<const std::uint8_t> data, bool needs_zlp) {
 void OtgFsDcd::ep0_receive(std::size_t length) {
   ep0_expect_data_ = true;
   ep0_rx_len_ = 0;
-  otg::doeptsiz(0).write(kOnePacket | (length < 64 ? length : 64U));
+  otg::doeptsiz(0).write(kOnePacket | static_cast<std::uint32_t>(length < 64 ? length : 64U));
   otg::doepctl(0).set(kEpEna | kCnak);
 }
 
@@ -252,10 +261,28 @@ void OtgFsDcd::configure_hid_endpoints(bool open) {
   arm_ep1_out();
 }
 
+bool OtgFsDcd::hid_busy() const { return ep1_busy_; }
+
+void OtgFsDcd::hid_halt(bool in, bool halt) {
+  const Reg ctl = in ? otg::diepctl(usb::kHidEndpoint) : otg::doepctl(usb::kHidEndpoint);
+  if (halt) {
+    ctl.set(kStall);
+    if (in) {  // a packet still in the FIFO would go out after the halt: drop it
+      otg::grstctl.write((1U << 5U) | (usb::kHidEndpoint << 6U));
+      wait_clear(otg::grstctl, 1U << 5U);
+      ep1_busy_ = false;
+    }
+    return;
+  }
+  // Clear the stall and restart the data toggle at DATA0.
+  ctl.write((ctl.read() & ~kStall) | kSd0Pid);
+  if (!in) arm_ep1_out();
+}
+
 bool OtgFsDcd::hid_send(std::span<const std::uint8_t> packet) {
   if (ep1_busy_ || (otg::diepctl(usb::kHidEndpoint).read() & kUsbAep) == 0) return false;
   ep1_busy_ = true;
-  otg::dieptsiz(usb::kHidEndpoint).write(kOnePacket | packet.size());
+  otg::dieptsiz(usb::kHidEndpoint).write(kOnePacket | static_cast<std::uint32_t>(packet.size()));
   otg::diepctl(usb::kHidEndpoint).set(kEpEna | kCnak);
   write_fifo(usb::kHidEndpoint, packet.data(), packet.size());
   return true;

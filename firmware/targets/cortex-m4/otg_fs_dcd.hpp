@@ -28,6 +28,8 @@ class OtgFsDcd final : public usb::Dcd {
   void ep0_status() override;
   void ep0_stall() override;
   bool hid_send(std::span<const std::uint8_t> packet) override;
+  [[nodiscard]] bool hid_busy() const override;
+  void hid_halt(bool in, bool halt) override;
 
  private:
   void bus_reset();

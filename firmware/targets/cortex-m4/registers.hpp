@@ -6,6 +6,23 @@
 
 namespace tonus::f405 {
 
+#if defined(TONUS_FAKE_REGISTERS)
+// Host tests (tests/firmware/chip): every access goes to a fake register file
+// whose hooks model the hardware's answers (ready flags, FIFOs, counters).
+std::uint32_t fake_register_read(std::uint32_t address);
+void fake_register_write(std::uint32_t address, std::uint32_t value);
+struct Reg {
+  std::uint32_t address;
+  [[nodiscard]] std::uint32_t read() const { return fake_register_read(address); }
+  void write(std::uint32_t v) const { fake_register_write(address, v); }
+  void set(std::uint32_t bits) const { write(read() | bits); }
+  void clear(std::uint32_t bits) const { write(read() & ~bits); }
+};
+// The CPU's side of the fake: interrupt masking and barriers are no-ops.
+inline void disable_irq() {}
+inline void enable_irq() {}
+inline void dsb() {}
+#else
 struct Reg {
   std::uint32_t address;
   [[nodiscard]] volatile std::uint32_t& operator*() const {
@@ -16,13 +33,21 @@ struct Reg {
   void set(std::uint32_t bits) const { **this = **this | bits; }
   void clear(std::uint32_t bits) const { **this = **this & ~bits; }
 };
+inline void disable_irq() { asm volatile("cpsid i" ::: "memory"); }
+inline void enable_irq() { asm volatile("cpsie i" ::: "memory"); }
+inline void dsb() { asm volatile("dsb" ::: "memory"); }
+#endif
 
 constexpr Reg at(std::uint32_t base, std::uint32_t offset) { return Reg{base + offset}; }
 
 // Core peripherals
 namespace scb {
+inline constexpr Reg icsr = {0xE000ED04};
 inline constexpr Reg vtor = {0xE000ED08};
 inline constexpr Reg aircr = {0xE000ED0C};
+inline constexpr Reg ccr = {0xE000ED14};
+inline constexpr Reg cfsr = {0xE000ED28};
+inline constexpr Reg hfsr = {0xE000ED2C};
 inline constexpr Reg cpacr = {0xE000ED88};
 }  // namespace scb
 namespace systick {
@@ -32,8 +57,11 @@ inline constexpr Reg val = {0xE000E018};
 }  // namespace systick
 namespace nvic {
 inline void enable(unsigned irq) { Reg{0xE000E100 + 4 * (irq / 32)}.write(1U << (irq % 32)); }
+// IPR: one byte per interrupt, written as its aligned word (a read-modify-write).
 inline void priority(unsigned irq, std::uint8_t prio) {
-  *reinterpret_cast<volatile std::uint8_t*>(0xE000E400 + irq) = prio;  // NOLINT(performance-no-int-to-ptr)
+  const Reg ipr{0xE000E400 + 4 * (irq / 4)};
+  const unsigned shift = 8 * (irq % 4);
+  ipr.write((ipr.read() & ~(0xFFU << shift)) | (static_cast<std::uint32_t>(prio) << shift));
 }
 }  // namespace nvic
 
@@ -144,6 +172,8 @@ inline constexpr Reg ffa1r = at(kBase, 0x214);
 inline constexpr Reg fa1r = at(kBase, 0x21C);
 inline constexpr Reg f0r1 = at(kBase, 0x240);
 inline constexpr Reg f0r2 = at(kBase, 0x244);
+inline constexpr Reg f1r1 = at(kBase, 0x248);
+inline constexpr Reg f1r2 = at(kBase, 0x24C);
 }  // namespace can1
 
 // USB OTG full-speed core (RM0090 section 34.16), device mode.

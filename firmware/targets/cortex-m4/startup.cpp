@@ -3,6 +3,7 @@
 // No C library start-up files are linked (-nostartfiles).
 #include <cstdint>
 
+#include "bootloader.hpp"
 #include "clock.hpp"
 #include "registers.hpp"
 
@@ -75,6 +76,7 @@ constexpr VectorTable make_table() {
 __attribute__((section(".isr_vector"), used)) const VectorTable g_vectors = make_table();
 
 extern "C" __attribute__((section(".text.Reset_Handler"), noreturn)) void Reset_Handler() {
+  jump_to_bootloader_if_requested();  // a firmware update asked for the ROM bootloader
   // The FPU first: the compiler may use VFP registers anywhere after this.
   tonus::f405::scb::cpacr.set(0xFU << 20U);  // CP10, CP11 full access
   asm volatile("dsb\n\tisb" ::: "memory");
@@ -94,7 +96,13 @@ extern "C" void Default_Handler() {
   }
 }
 
-extern "C" void HardFault_Handler() {
-  for (;;) {
-  }
+// Passes the stacked frame (MSP or PSP, from EXC_RETURN bit 2) to
+// hard_fault_dispatch (probe.cpp), which returns from the exception itself.
+extern "C" __attribute__((naked)) void HardFault_Handler() {
+  asm volatile(
+      "tst lr, #4\n\t"
+      "ite eq\n\t"
+      "mrseq r0, msp\n\t"
+      "mrsne r0, psp\n\t"
+      "b hard_fault_dispatch\n\t");
 }

@@ -7,6 +7,7 @@
 #include <csignal>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <thread>
 
 #include "emg_recording.hpp"
@@ -36,6 +37,9 @@ struct Options {
   int hid_fd = -1, can_fd = -1;
   std::string storage;
   bool quiet = false;
+  std::int64_t clock_offset_us = 0;  // real time: device clock = offset + host steady us * (1 + ppm 1e-6)
+  double clock_drift_ppm = 0.0;
+  bool clock_mapped = false;
 };
 
 struct Observer {
@@ -48,7 +52,8 @@ struct Observer {
 };
 
 void write_json(const std::string& path, const Options& opt, const std::string& source, double seconds,
-                const fw::Device& dev, const sim::Summary& s, const fw::ChainDelay& delay) {
+                const fw::Device& dev, const sim::Summary& s, const fw::ChainDelay& delay,
+                const sim::StepLatency* step) {
   auto out = fmt::output_file(path);
   const proto::DeviceStats st = dev.stats();
   const auto list = [](auto values) {
@@ -88,14 +93,19 @@ void write_json(const std::string& path, const Options& opt, const std::string& 
       "  \"first_flag_s\": {{\"electrode_off\": {}, \"saturation\": {}, \"artifact\": {}, \"block_lost\": {:.4f}}},\n",
       list(s.first_off_s), list(s.first_saturation_s), list(s.first_artifact_s), s.first_block_lost_s);
   out.print("  \"status_seen\": {},\n", s.status_seen);
-  out.print("  \"group_delay_ms\": {{\"filters\": {:.3f}, \"envelope\": {:.3f}, \"total\": {:.3f}}}\n",
+  out.print("  \"group_delay_ms\": {{\"filters\": {:.3f}, \"envelope\": {:.3f}, \"total\": {:.3f}}},\n",
             delay.filters_s * 1e3, delay.envelope_s * 1e3, delay.total_s() * 1e3);
+  // Step to level, device time, measured on the level stream (--synthetic step only; null otherwise).
+  const auto ms = [&](double v) { return step == nullptr || v < 0.0 ? std::string("null") : fmt::format("{:.1f}", v); };
+  out.print("  \"level_latency_10_ms\": {},\n  \"level_latency_50_ms\": {},\n  \"level_latency_90_ms\": {}\n",
+            ms(step ? step->ms10 : -1.0), ms(step ? step->ms50 : -1.0), ms(step ? step->ms90 : -1.0));
   out.print("}}\n");
 }
 
 int run(const Options& opt) {
   std::unique_ptr<sim::FrameSource> source;
   std::string source_name;
+  std::optional<std::size_t> step_frame;  // --synthetic step: the frame the effort changes at
   if (!opt.recording.empty()) {
     sim::Recording rec;
     std::string error;
@@ -112,7 +122,8 @@ int run(const Options& opt) {
   } else {
     fw::SynthSpec spec;
     if (!fw::parse_scenario(opt.synthetic.c_str(), spec.scenario)) {
-      fmt::print(stderr, "tonus-band-sim: unknown scenario '{}' (rest, ramp, faults, bursts, hum, dropout, selftest)\n",
+      fmt::print(stderr,
+                 "tonus-band-sim: unknown scenario '{}' (rest, ramp, faults, bursts, hum, dropout, selftest, step)\n",
                  opt.synthetic);
       return 2;
     }
@@ -121,6 +132,7 @@ int run(const Options& opt) {
     spec.seconds = static_cast<float>(opt.seconds);
     spec.mains_hz = static_cast<float>(opt.mains_hz);
     source_name = fmt::format("synthetic {}", opt.synthetic);
+    if (spec.scenario == fw::Scenario::step) step_frame = fw::step_frame(spec);
     source = sim::make_synthetic_source(spec);
   }
 
@@ -134,6 +146,7 @@ int run(const Options& opt) {
   }
 
   sim::SimClock clock(!opt.fast);
+  if (opt.clock_mapped) clock.set_host_mapping(opt.clock_offset_us, opt.clock_drift_ppm);
   // 1 ms blocks as on the band (2 frames at 2 kHz), at least one frame.
   const auto block_frames = std::max<std::size_t>(1, static_cast<std::size_t>(source->sample_rate_hz() / 1000.0F));
   sim::SimSampler sampler(*source, clock, block_frames);
@@ -174,6 +187,7 @@ int run(const Options& opt) {
   hal::Board board{sampler, clock, storage, led, watchdog, system, hid.get(), can, 0x7090000000000001ULL, 1};
   static fw::Device device(board);  // static: ~10 KiB of state, as on the band
   Observer observer;
+  observer.summary.keep_levels = step_frame.has_value();
   device.set_report_observer(&Observer::on_report, &observer);
   device.boot();
   if (device.boot_load_result() != fw::LoadResult::loaded && !opt.storage.empty() && !opt.quiet) {
@@ -191,7 +205,10 @@ int run(const Options& opt) {
     if (!opt.fast) std::this_thread::sleep_until(wall_start + std::chrono::microseconds(sampler.next_block_start_us()));
     more = sampler.produce();
     device.poll();
-    if (system.take_reset()) device.boot();  // what the band does after NVIC_SystemReset
+    if (system.take_reset()) {  // what the band does after NVIC_SystemReset: its clock restarts too
+      clock.restart();
+      device.boot();
+    }
     // A host that connected over an inherited fd and went away ends the run.
     if ((opt.hid_fd >= 0 && hid_ep.peer_gone()) || (opt.can_fd >= 0 && can_ep.peer_gone())) {
       if (!opt.quiet) fmt::print(stderr, "tonus-band-sim: host closed the link, stopping\n");
@@ -220,15 +237,25 @@ int run(const Options& opt) {
     fmt::print("  chain group delay: filters {:.2f} ms at {:.0f} Hz + envelope {:.2f} ms = {:.2f} ms\n",
                delay.filters_s * 1e3, fw::kReferenceEmgHz, delay.envelope_s * 1e3, delay.total_s() * 1e3);
   }
-  if (!opt.json.empty()) write_json(opt.json, opt, source_name, seconds, device, s, delay);
+  std::optional<sim::StepLatency> step;
+  if (step_frame && !s.level_time_us.empty()) {
+    const std::uint64_t step_us = sim::frame_time_us(s.level_time_us.front(), *step_frame,
+                                                     device.config().sample_rate_hz, device.config().report_rate_hz);
+    step = sim::step_latency(s.level_time_us, s.levels, step_us);
+    if (!opt.quiet) {
+      fmt::print("  step to level (device time): 10 % {:.1f} ms  50 % {:.1f} ms  90 % {:.1f} ms ({} groups)\n",
+                 step->ms10, step->ms50, step->ms90, step->groups);
+    }
+  }
+  if (!opt.json.empty()) write_json(opt.json, opt, source_name, seconds, device, s, delay, step ? &*step : nullptr);
   return 0;
 }
 
 int cli_main(int argc, char** argv) {
   CLI::App app{"tonus-band-sim: the band firmware core on Linux (synthetic EMG or a recording)"};
   Options opt;
-  auto* synth =
-      app.add_option("--synthetic", opt.synthetic, "scenario: rest, ramp, faults, bursts, hum, dropout, selftest");
+  auto* synth = app.add_option("--synthetic", opt.synthetic,
+                               "scenario: rest, ramp, faults, bursts, hum, dropout, selftest, step");
   auto* rec =
       app.add_option("--recording", opt.recording, "EMG recording (BioSPPy text or Myo CSV)")->check(CLI::ExistingFile);
   synth->excludes(rec);
@@ -246,7 +273,17 @@ int cli_main(int argc, char** argv) {
   app.add_option("--can-fd", opt.can_fd, "serve the CAN link on an inherited connected SOCK_SEQPACKET fd");
   app.add_option("--storage", opt.storage, "file backing the simulated flash (config and calibration)");
   app.add_flag("--quiet", opt.quiet, "no summary on stdout");
+  // A known device clock, so a host's time sync can be checked against the truth.
+  auto* offset = app.add_option("--clock-offset-us", opt.clock_offset_us,
+                                "real time: device clock = OFFSET + host CLOCK_MONOTONIC us * (1 + drift)");
+  auto* drift = app.add_option("--clock-drift-ppm", opt.clock_drift_ppm, "real time: device clock drift, ppm")
+                    ->check(CLI::Range(-1000.0, 1000.0));
   CLI11_PARSE(app, argc, argv);
+  opt.clock_mapped = offset->count() > 0 || drift->count() > 0;
+  if (opt.clock_mapped && opt.fast) {
+    fmt::print(stderr, "tonus-band-sim: --clock-offset-us and --clock-drift-ppm need real time (no --fast)\n");
+    return 2;
+  }
   if (opt.synthetic.empty() && opt.recording.empty()) {
     fmt::print(stderr, "tonus-band-sim: give --synthetic NAME or --recording FILE\n");
     return 2;

@@ -6,8 +6,10 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <fstream>
+#include <random>
 
 #include "tonus/protocol/candump.hpp"
 
@@ -74,10 +76,10 @@ proto::CanFrame from_socketcan(const can_frame& f) {
   return out;
 }
 
-void log_frame(std::FILE* file, const hal::Clock& clock, const proto::CanFrame& frame) {
+void log_frame(std::FILE* file, const SimClock& clock, const proto::CanFrame& frame) {
   if (file == nullptr) return;
   proto::candump::Record rec{};
-  rec.time_us = clock.now_us();
+  rec.time_us = clock.log_time_us();
   proto::candump::set_iface(rec, "vcan0");
   rec.frame = frame;
   std::array<char, proto::candump::kMaxLine + 1> line{};
@@ -95,9 +97,48 @@ std::unique_ptr<FrameSource> make_recording_source(Recording rec) {
 }
 
 std::uint64_t SimClock::now_us() const {
-  if (!realtime_) return virtual_us_;
+  if (!realtime_) return since_restart(virtual_us_);
   const auto d = std::chrono::steady_clock::now() - start_;
-  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(d).count());
+  return since_restart(
+      from_elapsed_us(static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(d).count())));
+}
+
+std::uint64_t SimClock::log_time_us() const {
+  if (!realtime_) return unix_start_us_ + virtual_us_;
+  const auto d = std::chrono::steady_clock::now() - start_;
+  return unix_start_us_ + static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(d).count());
+}
+
+void SimClock::restart() {
+  if (!realtime_) {
+    restart_base_us_ = virtual_us_;
+    return;
+  }
+  const auto d = std::chrono::steady_clock::now() - start_;
+  restart_base_us_ =
+      from_elapsed_us(static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(d).count()));
+}
+
+void SimClock::set_host_mapping(std::int64_t offset_us, double drift_ppm) {
+  mapped_ = true;
+  offset_us_ = offset_us;
+  drift_ppm_ = drift_ppm;
+}
+
+std::uint64_t SimClock::from_elapsed_us(std::uint64_t elapsed_us) const {
+  if (!mapped_) return elapsed_us;
+  const auto start_us = std::chrono::duration_cast<std::chrono::microseconds>(start_.time_since_epoch()).count();
+  const double host_us = static_cast<double>(start_us) + static_cast<double>(elapsed_us);
+  const double device_us = static_cast<double>(offset_us_) + host_us * (1.0 + drift_ppm_ * 1e-6);
+  return device_us > 0.0 ? static_cast<std::uint64_t>(std::llround(device_us)) : 0;  // a clock never reads below 0
+}
+
+SimSystem::SimSystem() {
+  // Differs between processes with near certainty; the band uses a retained counter instead.
+  std::random_device rd;
+  const auto now = static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count());
+  const std::uint64_t mixed = rd() ^ static_cast<std::uint64_t>(::getpid()) ^ now ^ (now >> 17U);
+  epoch_ = static_cast<std::uint8_t>(mixed % 255U + 1U);
 }
 
 bool SimSampler::start(std::uint16_t rate_hz) {
@@ -127,7 +168,7 @@ bool SimSampler::produce() {
   }
   if (ready_[write_half_]) ++dropped_;  // the core never released this half: the DMA overwrote it
   b.sequence = seq;
-  b.first_sample_us = start;
+  b.first_sample_us = clock_.since_restart(clock_.realtime() ? clock_.from_elapsed_us(start) : start);
   b.frames = static_cast<std::uint16_t>(n);
   ready_[write_half_] = true;
   if (ready_[read_half_] == false) read_half_ = write_half_;
@@ -158,8 +199,10 @@ bool FlashStorage::read(std::size_t offset, std::span<std::uint8_t> out) {
   return true;
 }
 
-bool FlashStorage::erase() {
-  std::fill(bytes_.begin(), bytes_.end(), std::uint8_t{0xFF});
+bool FlashStorage::erase(std::size_t sector) {
+  if (sector >= kSectors) return false;
+  const auto first = bytes_.begin() + static_cast<std::ptrdiff_t>(sector * kSectorSize);
+  std::fill(first, first + static_cast<std::ptrdiff_t>(kSectorSize), std::uint8_t{0xFF});
   persist();
   return true;
 }

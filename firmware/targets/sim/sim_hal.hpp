@@ -43,11 +43,33 @@ class SimClock final : public hal::Clock {
   [[nodiscard]] std::uint64_t now_us() const override;
   void advance_to(std::uint64_t t_us) { virtual_us_ = t_us > virtual_us_ ? t_us : virtual_us_; }
   [[nodiscard]] bool realtime() const { return realtime_; }
+  // Real time only: the device clock reads offset_us + h * (1 + drift_ppm * 1e-6)
+  // at host steady time h (CLOCK_MONOTONIC, us), a truth a host's time sync can be checked against.
+  void set_host_mapping(std::int64_t offset_us, double drift_ppm);
+  // Device time of `elapsed_us` after start in real time (the sampler's stamps).
+  [[nodiscard]] std::uint64_t from_elapsed_us(std::uint64_t elapsed_us) const;
+  // A reboot: like the band's SysTick count, the device clock starts again from 0.
+  void restart();
+  // Wall-clock time for logs (candump): the Unix time at start plus the time
+  // run since, unaffected by restarts, so a log's time base never jumps back.
+  [[nodiscard]] std::uint64_t log_time_us() const;
+  // Device time of a sampler stamp taken on the clock's running base (fast: virtual us,
+  // real time: from_elapsed_us), after the last restart; stamps from before it give 0.
+  [[nodiscard]] std::uint64_t since_restart(std::uint64_t base_us) const {
+    return base_us > restart_base_us_ ? base_us - restart_base_us_ : 0;
+  }
 
  private:
   bool realtime_;
   std::chrono::steady_clock::time_point start_;
+  std::uint64_t unix_start_us_ = static_cast<std::uint64_t>(
+      std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+          .count());
   std::uint64_t virtual_us_ = 0;
+  bool mapped_ = false;
+  std::uint64_t restart_base_us_ = 0;
+  std::int64_t offset_us_ = 0;
+  double drift_ppm_ = 0.0;
 };
 
 class SimSampler final : public hal::EmgSampler {
@@ -81,11 +103,15 @@ class SimSampler final : public hal::EmgSampler {
 
 class FlashStorage final : public hal::Storage {
  public:
-  static constexpr std::size_t kSize = std::size_t{16} * 1024;  // one STM32F405 sector 1
+  static constexpr std::size_t kSectorSize = std::size_t{16} * 1024;  // STM32F405 sectors 1 and 2
+  static constexpr std::size_t kSectors = 2;
+  static constexpr std::size_t kSize = kSectorSize * kSectors;
+  // A file written by an older simulator (one sector) is read into the first.
   explicit FlashStorage(std::string path = {});
-  [[nodiscard]] std::size_t size() const override { return bytes_.size(); }
+  [[nodiscard]] std::size_t sector_size() const override { return kSectorSize; }
+  [[nodiscard]] std::size_t sector_count() const override { return kSectors; }
   bool read(std::size_t offset, std::span<std::uint8_t> out) override;
-  bool erase() override;
+  bool erase(std::size_t sector) override;
   bool program(std::size_t offset, std::span<const std::uint8_t> data) override;
   std::vector<std::uint8_t>& bytes() { return bytes_; }
 
@@ -116,15 +142,34 @@ class SimWatchdog final : public hal::Watchdog {
 
 class SimSystem final : public hal::SystemControl {
  public:
+  SimSystem();  // a per-process boot epoch, never 0
   void reset() override { requested_ = true; }
+  // The reboot the band would do; the next boot gets the next epoch.
   bool take_reset() {
     const bool r = requested_;
     requested_ = false;
+    if (r) {
+      epoch_ = static_cast<std::uint8_t>(epoch_ % 255U + 1U);
+      cause_ = proto::ResetCause::software;
+    }
     return r;
   }
+  [[nodiscard]] std::uint8_t boot_epoch() const override { return epoch_; }
+  [[nodiscard]] proto::ResetCause reset_cause() const override { return cause_; }
+  // The simulated band "has" the DFU bootloader: entering it is counted and
+  // comes straight back as a software reboot (no image is flashed here).
+  [[nodiscard]] bool has_bootloader() const override { return true; }
+  void enter_bootloader() override {
+    ++bootloader_entries_;
+    requested_ = true;
+  }
+  [[nodiscard]] int bootloader_entries() const { return bootloader_entries_; }
 
  private:
   bool requested_ = false;
+  std::uint8_t epoch_ = 1;
+  proto::ResetCause cause_ = proto::ResetCause::power_on;
+  int bootloader_entries_ = 0;
 };
 
 // A SOCK_SEQPACKET endpoint: an inherited connected fd, or a listening socket
@@ -161,6 +206,8 @@ class SeqpacketHid final : public hal::UsbHid {
   explicit SeqpacketHid(SeqpacketEndpoint& ep) : ep_(ep) {}
   [[nodiscard]] bool connected() const override { return ep_.connected(); }
   bool send_input(const proto::hid::Report& report) override { return ep_.send(report); }
+  void service() override {}                                 // sends go straight to the socket
+  [[nodiscard]] bool idle() const override { return true; }  // nothing is ever held back
   bool receive_output(proto::hid::Report& report, std::size_t& length) override;
 
  private:
@@ -169,16 +216,17 @@ class SeqpacketHid final : public hal::UsbHid {
 
 class SeqpacketCan final : public hal::CanPort {
  public:
-  SeqpacketCan(SeqpacketEndpoint& ep, const hal::Clock& clock, std::FILE* candump)
+  SeqpacketCan(SeqpacketEndpoint& ep, const SimClock& clock, std::FILE* candump)
       : ep_(ep), clock_(clock), candump_(candump) {}
   bool send(const proto::CanFrame& frame) override;
   bool receive(proto::CanFrame& frame) override;
+  [[nodiscard]] bool idle() const override { return true; }  // sends go straight to the socket
   [[nodiscard]] std::uint64_t frames_sent() const { return sent_; }
 
  private:
   void log(const proto::CanFrame& frame);
   SeqpacketEndpoint& ep_;
-  const hal::Clock& clock_;
+  const SimClock& clock_;
   std::FILE* candump_;
   std::uint64_t sent_ = 0;
 };
@@ -186,12 +234,13 @@ class SeqpacketCan final : public hal::CanPort {
 // A CAN port with no bus attached: frames are only logged (candump), never lost.
 class LogOnlyCan final : public hal::CanPort {
  public:
-  LogOnlyCan(const hal::Clock& clock, std::FILE* candump) : clock_(clock), candump_(candump) {}
+  LogOnlyCan(const SimClock& clock, std::FILE* candump) : clock_(clock), candump_(candump) {}
   bool send(const proto::CanFrame& frame) override;
   bool receive(proto::CanFrame&) override { return false; }
+  [[nodiscard]] bool idle() const override { return true; }
 
  private:
-  const hal::Clock& clock_;
+  const SimClock& clock_;
   std::FILE* candump_;
 };
 

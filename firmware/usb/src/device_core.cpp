@@ -11,6 +11,10 @@ constexpr std::uint8_t kDirIn = 0x80;
 constexpr std::uint8_t kTypeMask = 0x60, kTypeStandard = 0x00, kTypeClass = 0x20;
 constexpr std::uint8_t kRecipientMask = 0x1F, kRecipientDevice = 0, kRecipientInterface = 1, kRecipientEndpoint = 2;
 
+// Standard feature selectors (table 9-6)
+constexpr std::uint16_t kEndpointHalt = 0;
+constexpr std::uint8_t kEp1In = 0x80U | kHidEndpoint, kEp1Out = kHidEndpoint;
+
 // Standard requests (table 9-4)
 constexpr std::uint8_t kGetStatus = 0, kClearFeature = 1, kSetFeature = 3, kSetAddress = 5, kGetDescriptor = 6,
                        kGetConfiguration = 8, kSetConfiguration = 9, kGetInterface = 10, kSetInterface = 11;
@@ -28,10 +32,25 @@ SetupPacket SetupPacket::parse(std::span<const std::uint8_t, 8> raw) {
 
 void DeviceCore::on_bus_reset() {
   configured_.store(false);
+  suspended_.store(false);
+  in_halted_.store(false);
+  out_halted_.store(false);
+  drop_input_.store(true);
   address_ = 0;
   configuration_ = 0;
   set_report_pending_ = false;
   dcd_.configure_hid_endpoints(false);
+}
+
+void DeviceCore::on_suspend() {
+  suspended_.store(true);
+  suspends_.fetch_add(1);
+}
+
+void DeviceCore::on_resume() {
+  if (!suspended_.load()) return;
+  suspended_.store(false);
+  resumes_.fetch_add(1);
 }
 
 void DeviceCore::reply(std::span<const std::uint8_t> data, std::uint16_t requested) {
@@ -101,19 +120,21 @@ void DeviceCore::standard_request(const SetupPacket& s) {
       ep0_buffer_[0] = configuration_;
       reply(std::span<const std::uint8_t>(ep0_buffer_).first(1), s.length);
       return;
-    case kGetStatus:
-      ep0_buffer_[0] = 0;  // bus powered, no remote wake-up, endpoint not halted
+    case kGetStatus: {
+      // Device: bus powered, no remote wake-up. Endpoint: bit 0 = halted.
+      const auto ep = static_cast<std::uint8_t>(s.index & 0xFFU);
+      bool halted = false;
+      if (recipient == kRecipientEndpoint) {
+        if (ep == kEp1In) halted = in_halted_.load();
+        if (ep == kEp1Out) halted = out_halted_.load();
+      }
+      ep0_buffer_[0] = halted ? 1 : 0;
       ep0_buffer_[1] = 0;
       reply(std::span<const std::uint8_t>(ep0_buffer_).first(2), s.length);
       return;
+    }
     case kClearFeature:
-    case kSetFeature:
-      // ENDPOINT_HALT on EP1 is accepted (the interrupt endpoints never halt by themselves).
-      if (recipient == kRecipientEndpoint || recipient == kRecipientDevice) {
-        dcd_.ep0_status();
-        return;
-      }
-      break;
+    case kSetFeature: feature(s, s.request == kSetFeature); return;
     case kGetInterface:
       if (recipient != kRecipientInterface || configuration_ == 0) break;
       ep0_buffer_[0] = 0;
@@ -126,6 +147,28 @@ void DeviceCore::standard_request(const SetupPacket& s) {
     default: break;
   }
   dcd_.ep0_stall();
+}
+
+void DeviceCore::feature(const SetupPacket& s, bool set) {
+  // Only ENDPOINT_HALT on EP0 (a no-op) and EP1 exists: the band has no remote
+  // wake-up and is full speed only (no test modes), so other features stall.
+  const auto ep = static_cast<std::uint8_t>(s.index & 0xFFU);
+  if ((s.request_type & kRecipientMask) != kRecipientEndpoint || s.value != kEndpointHalt) {
+    dcd_.ep0_stall();
+    return;
+  }
+  if (ep == 0 || ep == 0x80) {
+    dcd_.ep0_status();
+    return;
+  }
+  if ((ep != kEp1In && ep != kEp1Out) || configuration_ == 0) {
+    dcd_.ep0_stall();
+    return;
+  }
+  const bool in = ep == kEp1In;
+  dcd_.hid_halt(in, set);
+  (in ? in_halted_ : out_halted_).store(set);
+  dcd_.ep0_status();
 }
 
 void DeviceCore::class_request(const SetupPacket& s) {
@@ -213,19 +256,59 @@ bool DeviceCore::receive_output(proto::hid::Report& report, std::size_t& length)
 }
 
 bool DeviceCore::send_input(const proto::hid::Report& report) {
-  if (!configured_.load()) return false;
+  if (!connected()) return false;
+  forget_old_session();
+  if (report[0] == proto::hid::kReportIdStream) {
+    if (stream_waiting_) ++stream_superseded_;  // the newest report carries the newest levels
+    stream_ = report;
+    stream_waiting_ = true;
+  } else if (report[0] == proto::hid::kReportIdResponse) {
+    if (response_count_ == kResponseQueue) return false;
+    responses_[(response_head_ + response_count_) % kResponseQueue] = report;
+    ++response_count_;
+  } else {
+    return false;
+  }
+  service();
+  return true;
+}
+
+void DeviceCore::forget_old_session() {
+  if (!drop_input_.exchange(false)) return;
+  if (stream_waiting_) ++stream_superseded_;
+  stream_waiting_ = false;
+  response_count_ = 0;
+}
+
+void DeviceCore::service() {
+  forget_old_session();
+  if (!connected() || in_halted_.load()) return;
+  const bool response_first = response_count_ != 0 && (last_was_stream_ || !stream_waiting_);
+  if (response_first) {
+    if (!load(responses_[response_head_])) return;
+    response_head_ = (response_head_ + 1) % kResponseQueue;
+    --response_count_;
+    last_was_stream_ = false;
+  } else if (stream_waiting_) {
+    if (!load(stream_)) return;
+    stream_waiting_ = false;
+    last_was_stream_ = true;
+  }
+}
+
+bool DeviceCore::idle() const { return !stream_waiting_ && response_count_ == 0 && !dcd_.hid_busy(); }
+
+bool DeviceCore::load(const proto::hid::Report& report) {
   // The DCD refuses while the previous packet is still in flight (the host
-  // polls EP1 every 1 ms); it copies an accepted packet before returning.
+  // polls EP1 once per 1 ms frame); it copies an accepted packet before returning.
   static_assert(proto::hid::kReportSize == kHidPacket);
   if (!dcd_.hid_send(report)) return false;
-  const int kind = report[0] == proto::hid::kReportIdStream ? 0 : (report[0] == proto::hid::kReportIdResponse ? 1 : -1);
-  if (kind >= 0) {
-    LastInput& last = last_input_[static_cast<std::size_t>(kind)];
-    const auto next = static_cast<std::uint8_t>(last.published.load() ^ 1U);
-    last.slot[next] = report;
-    last.published.store(next);
-    last.any.store(true);
-  }
+  const int kind = report[0] == proto::hid::kReportIdStream ? 0 : 1;
+  LastInput& last = last_input_[static_cast<std::size_t>(kind)];
+  const auto next = static_cast<std::uint8_t>(last.published.load() ^ 1U);
+  last.slot[next] = report;
+  last.published.store(next);
+  last.any.store(true);
   return true;
 }
 

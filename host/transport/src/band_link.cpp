@@ -15,19 +15,70 @@ int remaining_ms(std::chrono::steady_clock::time_point deadline) {
 
 }  // namespace
 
-std::optional<proto::Response> BandLink::transact(const proto::Request& req, int timeout_ms, const StreamSink& sink) {
+LinkEvent BandLink::poll(int timeout_ms) {
+  using Verdict = proto::SequenceTracker::Verdict;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+  for (;;) {
+    LinkEvent e = read_event(remaining_ms(deadline));
+    if (e.kind == LinkEvent::Kind::heartbeat && e.restarted) {
+      tracker_.note_restart();
+      restart_noted_ = true;
+    }
+    if (e.kind == LinkEvent::Kind::reconnected) tracker_.note_reconnect();
+    if (e.kind != LinkEvent::Kind::stream) return e;
+    ++reports_;
+    const Verdict v = tracker_.push(e.stream.sequence, e.stream.boot_epoch);
+    const bool noted = restart_noted_;
+    restart_noted_ = false;
+    switch (v) {
+      case Verdict::first:
+      case Verdict::in_order:
+      case Verdict::gap:
+      case Verdict::resync:
+        e.restarted = v == Verdict::resync || (v == Verdict::first && noted);
+        ++delivered_;
+        return e;
+      case Verdict::late:
+        e.kind = LinkEvent::Kind::late_stream;
+        ++late_;
+        return e;
+      case Verdict::duplicate:
+      case Verdict::stale: break;  // counted by the tracker, never delivered
+    }
+    if (remaining_ms(deadline) == 0) return LinkEvent{};
+  }
+}
+
+std::optional<proto::Response> BandLink::transact(const proto::Request& req, int timeout_ms, const StreamSink& sink,
+                                                  std::int64_t* rx_host_us) {
   if (!send(req)) return std::nullopt;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
   for (;;) {
     const int left = remaining_ms(deadline);
     const LinkEvent e = poll(left);
-    if (e.kind == LinkEvent::Kind::closed) return std::nullopt;
+    if (e.kind == LinkEvent::Kind::closed || e.kind == LinkEvent::Kind::disconnected) return std::nullopt;
     if (e.kind == LinkEvent::Kind::stream && sink) sink(e.stream);
     if (e.kind == LinkEvent::Kind::response && e.response.token == req.token && e.response.opcode == req.opcode) {
+      if (rx_host_us != nullptr) *rx_host_us = e.rx_host_us;
       return e.response;
     }
     if (left == 0) return std::nullopt;
   }
+}
+
+LinkStats BandLink::stats() const {
+  LinkStats s;
+  s.reports = reports_;
+  s.delivered = delivered_;
+  s.late = late_;
+  s.lost = tracker_.lost();
+  s.duplicates = tracker_.duplicates();
+  s.stale = tracker_.stale();
+  s.restarts = tracker_.resyncs();
+  s.decode_errors = total_decode_errors();
+  s.disconnects = disconnects();
+  s.reconnects = reconnects();
+  return s;
 }
 
 bool HidBandLink::send(const proto::Request& req) {
@@ -36,7 +87,7 @@ bool HidBandLink::send(const proto::Request& req) {
   return t_.write(r);
 }
 
-LinkEvent HidBandLink::poll(int timeout_ms) {
+LinkEvent HidBandLink::read_event(int timeout_ms) {
   LinkEvent e;
   std::array<std::uint8_t, proto::hid::kReportSize + 1> buf{};
   const int n = t_.read(buf, timeout_ms);
@@ -45,6 +96,7 @@ LinkEvent HidBandLink::poll(int timeout_ms) {
     return e;
   }
   if (n == 0) return e;
+  e.rx_host_us = steady_now_us();
   const auto report = std::span<const std::uint8_t>(buf).first(static_cast<std::size_t>(n));
   if (buf[0] == proto::hid::kReportIdStream) {
     if (proto::hid::unpack_stream(report, e.stream) == proto::Error::ok) {
@@ -58,6 +110,7 @@ LinkEvent HidBandLink::poll(int timeout_ms) {
     }
   }
   ++decode_errors_;
+  e.rx_host_us = 0;
   return e;
 }
 
@@ -68,7 +121,7 @@ bool CanBandLink::send(const proto::Request& req) {
   std::size_t count = 0;
   if (proto::encode_request(req, bytes, n) != proto::Error::ok) return false;
   if (proto::can::segment(std::span<const std::uint8_t>(bytes).first(n), proto::can::Function::request, node_, frames,
-                          count) != proto::Error::ok) {
+                          count, id_base_) != proto::Error::ok) {
     return false;
   }
   for (std::size_t k = 0; k < count; ++k) {
@@ -77,7 +130,12 @@ bool CanBandLink::send(const proto::Request& req) {
   return true;
 }
 
-LinkEvent CanBandLink::poll(int timeout_ms) {
+std::int64_t CanBandLink::arrival_us() const {
+  const std::int64_t kernel = t_.last_rx_host_us();
+  return kernel != 0 ? kernel : steady_now_us();
+}
+
+LinkEvent CanBandLink::read_event(int timeout_ms) {
   LinkEvent e;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
   for (;;) {
@@ -90,10 +148,16 @@ LinkEvent CanBandLink::poll(int timeout_ms) {
     if (r == 0) return e;
     proto::can::Function fn{};
     std::uint8_t node = 0;
-    if (!proto::can::split_id(f.id, fn, node) || node != node_) continue;
+    if (!proto::can::split_frame(f, id_base_, fn, node) || node != node_) continue;
     if (fn == proto::can::Function::heartbeat) {
-      if (proto::can::decode_heartbeat(f, e.heartbeat) == proto::Error::ok) {
+      if (proto::can::decode_heartbeat(f, e.heartbeat, id_base_) == proto::Error::ok) {
+        // Back by less than half the u32 range: a reboot, not the 49.7-day wrap.
+        const std::uint32_t back = last_uptime_ms_ - e.heartbeat.uptime_ms;
+        e.restarted = have_uptime_ && e.heartbeat.uptime_ms < last_uptime_ms_ && back < 0x80000000U;
+        have_uptime_ = true;
+        last_uptime_ms_ = e.heartbeat.uptime_ms;
         e.kind = LinkEvent::Kind::heartbeat;
+        e.rx_host_us = arrival_us();
         return e;
       }
       ++decode_errors_;
@@ -108,6 +172,7 @@ LinkEvent CanBandLink::poll(int timeout_ms) {
       if (!complete) continue;
       if (proto::decode_response(responses_.message(), e.response) == proto::Error::ok) {
         e.kind = LinkEvent::Kind::response;
+        e.rx_host_us = arrival_us();
         return e;
       }
       ++decode_errors_;
@@ -121,6 +186,7 @@ LinkEvent CanBandLink::poll(int timeout_ms) {
     if (complete) {
       e.kind = LinkEvent::Kind::stream;
       e.stream = stream_.message();
+      e.rx_host_us = arrival_us();
       return e;
     }
   }

@@ -58,55 +58,106 @@ std::string check_band_descriptor(std::span<const std::uint8_t> descriptor) {
   return {};
 }
 
-std::unique_ptr<HidapiTransport> HidapiTransport::open(std::uint16_t vid, std::uint16_t pid, const std::wstring& serial,
-                                                       std::string& error) {
-  if (hid_init() != 0) {
+namespace {
+
+class HidapiDevice final : public HidDevice {
+ public:
+  HidapiDevice(hid_device* dev, std::string path) : dev_(dev), path_(std::move(path)) {}
+  ~HidapiDevice() override { hid_close(dev_); }
+  HidapiDevice(const HidapiDevice&) = delete;
+  HidapiDevice& operator=(const HidapiDevice&) = delete;
+  int read(std::span<std::uint8_t> out, int timeout_ms) override {
+    return hid_read_timeout(dev_, out.data(), out.size(), timeout_ms);
+  }
+  int write(std::span<const std::uint8_t> report) override { return hid_write(dev_, report.data(), report.size()); }
+  bool report_descriptor(std::vector<std::uint8_t>& out) override { return read_descriptor(dev_, path_, out); }
+  [[nodiscard]] std::string error() const override { return narrow(hid_error(dev_)); }
+
+ private:
+  hid_device* dev_;
+  std::string path_;
+};
+
+class Hidapi final : public HidBackend {
+ public:
+  bool init(std::string& error) override {
+    if (hid_init() == 0) return true;
     error = "hid_init failed: " + narrow(hid_error(nullptr));
-    return nullptr;
+    return false;
   }
-  // Enumerate to learn the hidraw path (needed for the descriptor on hidapi < 0.14).
-  std::string path;
-  hid_device_info* list = hid_enumerate(vid, pid);
-  for (hid_device_info* d = list; d != nullptr; d = d->next) {
-    if (!serial.empty() && (d->serial_number == nullptr || serial != d->serial_number)) continue;
-    path = d->path;
-    break;
+  std::vector<HidDeviceEntry> enumerate(std::uint16_t vid, std::uint16_t pid) override {
+    std::vector<HidDeviceEntry> out;
+    hid_device_info* list = hid_enumerate(vid, pid);
+    for (const hid_device_info* d = list; d != nullptr; d = d->next) {
+      HidDeviceEntry e;
+      e.path = d->path != nullptr ? d->path : "";
+      e.serial = d->serial_number != nullptr ? d->serial_number : L"";
+      e.vendor_id = d->vendor_id;
+      e.product_id = d->product_id;
+      out.push_back(std::move(e));
+    }
+    hid_free_enumeration(list);
+    return out;
   }
-  hid_free_enumeration(list);
-  if (path.empty()) {
-    error = "no tonus band with VID:PID " + std::to_string(vid) + ":" + std::to_string(pid) + " is plugged in";
-    return nullptr;
+  std::unique_ptr<HidDevice> open(const std::string& path, std::string& error) override {
+    hid_device* dev = hid_open_path(path.c_str());
+    if (dev == nullptr) {
+      error = narrow(hid_error(nullptr)) + " (udev permissions? see packaging/udev)";
+      return nullptr;
+    }
+    return std::make_unique<HidapiDevice>(dev, path);
   }
-  hid_device* dev = hid_open_path(path.c_str());
-  if (dev == nullptr) {
-    error = "cannot open " + path + ": " + narrow(hid_error(nullptr)) + " (udev permissions?)";
-    return nullptr;
-  }
-  std::unique_ptr<HidapiTransport> t(new HidapiTransport(dev, path));
-  if (!read_descriptor(dev, path, t->descriptor_)) {
-    error = "cannot read the report descriptor of " + path;
-    return nullptr;
-  }
-  if (std::string why = check_band_descriptor(t->descriptor_); !why.empty()) {
-    error = path + ": " + why;
-    return nullptr;
-  }
-  return t;
+};
+
+std::string hex4(std::uint16_t v) {
+  static constexpr char kDigits[] = "0123456789abcdef";
+  std::string s(4, '0');
+  for (int k = 3; k >= 0; --k, v = static_cast<std::uint16_t>(v >> 4U))
+    s[static_cast<std::size_t>(k)] = kDigits[v & 0xFU];
+  return s;
 }
 
-HidapiTransport::~HidapiTransport() {
-  if (dev_ != nullptr) hid_close(dev_);
+}  // namespace
+
+HidBackend& hidapi_backend() {
+  static Hidapi backend;
+  return backend;
+}
+
+std::unique_ptr<HidapiTransport> HidapiTransport::open(std::uint16_t vid, std::uint16_t pid, const std::wstring& serial,
+                                                       std::string& error, HidBackend& backend) {
+  if (!backend.init(error)) return nullptr;
+  std::string refused;
+  for (const HidDeviceEntry& d : backend.enumerate(vid, pid)) {
+    // hid_enumerate(0, 0) lists everything: keep to the ids asked for.
+    if ((vid != 0 && d.vendor_id != vid) || (pid != 0 && d.product_id != pid)) continue;
+    if (!serial.empty() && d.serial != serial) continue;
+    std::string why;
+    std::unique_ptr<HidDevice> dev = backend.open(d.path, why);
+    std::vector<std::uint8_t> descriptor;
+    if (dev == nullptr) {
+      why.insert(0, "cannot open: ");
+    } else if (!dev->report_descriptor(descriptor)) {
+      why = "cannot read the report descriptor";
+    } else {
+      why = check_band_descriptor(descriptor);
+    }
+    if (why.empty()) return std::unique_ptr<HidapiTransport>(new HidapiTransport(std::move(dev), d.path, descriptor));
+    refused += (refused.empty() ? "" : "; ") + d.path + ": " + why;
+  }
+  error = refused.empty() ? "no tonus band with VID:PID " + hex4(vid) + ":" + hex4(pid) + " is plugged in" : refused;
+  return nullptr;
 }
 
 int HidapiTransport::read(std::span<std::uint8_t> out, int timeout_ms) {
-  const int n = hid_read_timeout(dev_, out.data(), out.size(), timeout_ms);
-  if (n < 0) error_ = "hid_read_timeout: " + narrow(hid_error(dev_));
+  const int n = dev_->read(out, timeout_ms);
+  if (n < 0) error_ = "hid_read_timeout: " + dev_->error();
   return n;
 }
 
 bool HidapiTransport::write(std::span<const std::uint8_t> report) {
-  if (hid_write(dev_, report.data(), report.size()) == static_cast<int>(report.size())) return true;
-  error_ = "hid_write: " + narrow(hid_error(dev_));
+  if (dev_->write(report) == static_cast<int>(report.size())) return true;
+  error_ = "hid_write: " + dev_->error();
   return false;
 }
 

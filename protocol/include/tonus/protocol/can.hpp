@@ -18,6 +18,13 @@
 // Command messages (<= 63 bytes) are split in segments of 7 bytes after a
 // header byte: high nibble = segment count (1..9), low nibble = index.
 // protocol/tonus.dbc describes every frame for node 1.
+//
+// ID base (DeviceConfig.can_id_base, minor 1). These 11-bit ids reuse the
+// CANopen bases (0x580/0x600/0x700 are SDO and NMT error control), so a band
+// alone on its bus uses them (base 0) but a bus shared with CANopen devices
+// must not. A nonzero base moves the whole plan to 29-bit (extended) ids
+// base + plan id: CANopen's predefined connection set uses only 11-bit ids,
+// so the two never collide. The base is a multiple of 0x800 up to 0x1FFFF800.
 #pragma once
 
 #include <array>
@@ -74,12 +81,20 @@ enum class Function : std::uint16_t {
   heartbeat = 0x700,
 };
 
-constexpr std::uint32_t make_id(Function f, std::uint8_t node) {
-  return static_cast<std::uint32_t>(f) | (node & kNodeMask);
+inline constexpr std::uint32_t kIdBaseStep = 0x800;
+inline constexpr std::uint32_t kMaxIdBase = 0x1FFFF800;
+constexpr bool valid_id_base(std::uint32_t base) { return base % kIdBaseStep == 0 && base <= kMaxIdBase; }
+
+// The plan's id of a function and node at `id_base` (extended when nonzero).
+constexpr std::uint32_t make_id(Function f, std::uint8_t node, std::uint32_t id_base = 0) {
+  return id_base + (static_cast<std::uint32_t>(f) | (node & kNodeMask));
 }
 
 // Splits a standard id into function and node; false for ids outside the plan.
 bool split_id(std::uint32_t id, Function& f, std::uint8_t& node);
+// Splits a frame's id at `id_base`: false unless it is a data frame of the plan
+// (standard for base 0, extended with that base otherwise).
+bool split_frame(const CanFrame& frame, std::uint32_t id_base, Function& f, std::uint8_t& node);
 
 inline constexpr std::size_t kGroupsPerFrame = 4;
 inline constexpr std::size_t kChannelsPerFrame = 4;
@@ -88,7 +103,7 @@ inline constexpr std::size_t kMaxStreamFrames = 8;  // status + 2 levels + 4 env
 // Frames of one stream cycle, in send order. Envelope frames are included only
 // when `with_envelopes` (the device sends them every can_envelope_divider cycles).
 Error encode_stream(const StreamMessage& msg, std::uint8_t node, bool with_envelopes, std::span<CanFrame> out,
-                    std::size_t& count);
+                    std::size_t& count, std::uint32_t id_base = 0);
 
 // Reassembles stream cycles of one node. Frames of other nodes are ignored.
 // A cycle is delivered when its FLAGS frame arrives and every levels frame the
@@ -96,7 +111,7 @@ Error encode_stream(const StreamMessage& msg, std::uint8_t node, bool with_envel
 // values (envelopes_fresh() says whether this cycle carried them).
 class StreamAssembler {
  public:
-  explicit StreamAssembler(std::uint8_t node) : node_(node) {}
+  explicit StreamAssembler(std::uint8_t node, std::uint32_t id_base = 0) : node_(node), id_base_(id_base) {}
 
   // Returns Error::ok and sets `complete` when `message()` holds a new cycle.
   // Malformed frames return an error and void the cycle in progress.
@@ -111,6 +126,7 @@ class StreamAssembler {
   void abandon_cycle();
 
   std::uint8_t node_;
+  std::uint32_t id_base_;
   bool in_cycle_ = false;
   std::uint8_t seen_ = 0;  // bit per stream function index (levels0.. envelope3)
   std::array<std::uint8_t, 6> dlc_{};
@@ -132,8 +148,8 @@ struct Heartbeat {
   friend bool operator==(const Heartbeat&, const Heartbeat&) = default;
 };
 
-CanFrame encode_heartbeat(const Heartbeat& hb, std::uint8_t node);
-Error decode_heartbeat(const CanFrame& frame, Heartbeat& out);
+CanFrame encode_heartbeat(const Heartbeat& hb, std::uint8_t node, std::uint32_t id_base = 0);
+Error decode_heartbeat(const CanFrame& frame, Heartbeat& out, std::uint32_t id_base = 0);
 
 // Segmentation of a command request/response message (bytes as produced by
 // encode_request / encode_response) into REQUEST or RESPONSE frames.
@@ -141,14 +157,15 @@ inline constexpr std::size_t kSegmentData = 7;
 inline constexpr std::size_t kMaxSegments = (kMaxMessageSize + kSegmentData - 1) / kSegmentData;  // 9
 
 Error segment(std::span<const std::uint8_t> message, Function f, std::uint8_t node, std::span<CanFrame> out,
-              std::size_t& count);
+              std::size_t& count, std::uint32_t id_base = 0);
 
 // Collects the segments of one function/node. A new index-0 segment restarts;
 // a gap, duplicate or count change voids the message (Error::out_of_order).
 // The message's own length and CRC are checked by the command decoder.
 class Reassembler {
  public:
-  Reassembler(Function f, std::uint8_t node) : function_(f), node_(node) {}
+  Reassembler(Function f, std::uint8_t node, std::uint32_t id_base = 0)
+      : function_(f), node_(node), id_base_(id_base) {}
 
   Error push(const CanFrame& frame, bool& complete);
   [[nodiscard]] std::span<const std::uint8_t> message() const { return {buffer_.data(), size_}; }
@@ -157,6 +174,7 @@ class Reassembler {
  private:
   Function function_;
   std::uint8_t node_;
+  std::uint32_t id_base_;
   std::uint8_t total_ = 0;
   std::uint8_t expected_ = 0;
   std::size_t size_ = 0;

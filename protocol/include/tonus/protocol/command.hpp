@@ -21,6 +21,7 @@ enum class Opcode : std::uint8_t {
   get_device_info = 0x01,
   time_sync = 0x02,
   get_stats = 0x03,
+  get_log = 0x04,  // minor 1: the device's fault log
   calibration_start = 0x10,
   calibration_abort = 0x11,
   calibration_status = 0x12,
@@ -28,6 +29,7 @@ enum class Opcode : std::uint8_t {
   set_config = 0x21,
   save_config = 0x22,
   reset = 0x30,
+  enter_bootloader = 0x31,  // minor 1: reboot into the update bootloader (DFU)
 };
 
 bool is_known(Opcode op);

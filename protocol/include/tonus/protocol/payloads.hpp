@@ -18,9 +18,27 @@ namespace tonus::proto {
 
 inline constexpr std::uint8_t kPairUnused = 0xFF;  // pair_group entry of a pair feeding no group
 
-// get_device_info response.
+// Why the device last started (DeviceInfo.reset_cause).
+enum class ResetCause : std::uint8_t {
+  unknown = 0,
+  power_on = 1,  // power-on or brown-out reset
+  pin = 2,       // the reset pin (a debugger, a button)
+  software = 3,  // the `reset` command, or a firmware update
+  watchdog = 4,  // the independent or window watchdog
+  low_power = 5,
+};
+
+namespace feature_bit {
+inline constexpr std::uint32_t boot_epoch = 1U << 0U;  // the stream's byte 3 is a boot epoch
+inline constexpr std::uint32_t fault_log = 1U << 1U;   // get_log
+inline constexpr std::uint32_t bootloader = 1U << 2U;  // enter_bootloader reboots into an update bootloader
+}  // namespace feature_bit
+
+// get_device_info response. Minor 1 appended protocol_minor..reset_cause; a
+// 29-byte answer (minor 0) reads with those fields zero.
 struct DeviceInfo {
-  static constexpr std::size_t kWireSize = 29;
+  static constexpr std::size_t kMinWireSize = 29;
+  static constexpr std::size_t kWireSize = 43;
   std::uint8_t firmware_major = 0;
   std::uint8_t firmware_minor = 0;
   std::uint8_t firmware_patch = 0;
@@ -31,9 +49,15 @@ struct DeviceInfo {
   std::uint8_t group_count = 4;
   std::uint8_t pair_count = 4;
   std::uint16_t sample_rate_hz = 2000;
-  std::uint16_t report_rate_hz = 1000;
+  std::uint16_t report_rate_hz = 500;
   std::array<std::uint8_t, kMaxPairs> pair_group{};  // group of each pair, or kPairUnused
   std::uint8_t transports = 0;                       // transport_bit::*
+  // minor 1
+  std::uint8_t protocol_minor = 0;
+  std::uint32_t features = 0;    // feature_bit::*
+  std::uint32_t build_id = 0;    // the firmware's source revision (git commit, first 8 hex digits), 0 unknown
+  std::uint32_t boot_count = 0;  // boots since the storage was last erased, 0 unknown
+  ResetCause reset_cause = ResetCause::unknown;
 
   void write(ByteWriter& w) const;
   Error read(ByteReader& r);
@@ -133,9 +157,11 @@ enum class LevelCurve : std::uint8_t { linear = 0, power = 1 };
 // get_config response and set_config request. Frequencies in decihertz (0.1 Hz)
 // so that corners like 20.0 Hz and 450.0 Hz are exact integers on the wire.
 struct DeviceConfig {
-  static constexpr std::size_t kWireSize = 31;
+  static constexpr std::size_t kMinWireSize = 31;  // minor 0
+  static constexpr std::size_t kWireSize = 35;
   std::uint16_t sample_rate_hz = 2000;
-  std::uint16_t report_rate_hz = 1000;
+  // 500 Hz leaves every other 1 ms USB frame free for command responses.
+  std::uint16_t report_rate_hz = 500;
   std::uint16_t highpass_dhz = 200;  // 20.0 Hz (SENIAM); 0 = off
   std::uint16_t lowpass_dhz = 4500;  // 450.0 Hz; 0 = off
   std::uint8_t notch_hz = 50;        // 0 = off, 50 or 60
@@ -150,6 +176,9 @@ struct DeviceConfig {
   std::uint16_t curve_exponent_milli = 1000;
   std::uint8_t can_node_id = 1;            // 0..31
   std::uint8_t can_envelope_divider = 10;  // envelopes on CAN every Nth report; 0 = never
+  // minor 1: where the CAN id plan sits (can.hpp): 0 = the 11-bit ids, else a
+  // 29-bit base (a multiple of 0x800) for a bus shared with CANopen.
+  std::uint32_t can_id_base = 0;
 
   void write(ByteWriter& w) const;
   Error read(ByteReader& r);
@@ -175,6 +204,7 @@ enum class ConfigField : std::uint8_t {
   curve_exponent_milli,
   can_node_id,
   can_envelope_divider,
+  can_id_base,
 };
 
 const char* to_string(ConfigField f);
@@ -203,6 +233,47 @@ struct ResetRequest {
   void write(ByteWriter& w) const;
   Error read(ByteReader& r);
   friend bool operator==(const ResetRequest&, const ResetRequest&) = default;
+};
+
+// What a fault-log entry records.
+enum class FaultCode : std::uint8_t {
+  none = 0,               // an unused entry
+  sampler_restarted = 1,  // no sample block for 200 ms: the sampler was restarted (arg: restarts)
+  sampler_stalled = 2,    // still none after the restart: fault state, the watchdog will reset
+  storage_corrupt = 3,    // no valid record at boot: defaults in use (arg: LoadResult)
+  storage_error = 4,      // a save or its verification failed
+  watchdog_reset = 5,     // this boot followed a watchdog reset
+  blocks_lost = 6,        // sample blocks overwritten before processing (arg: count, saturating)
+  can_down = 7,           // the CAN port refused frames: no bus, or bus-off (arg: frames)
+  config_rejected = 8,    // a stored or requested configuration failed the device's check (arg: field)
+};
+
+// One fault-log entry: device time in ms of its first occurrence (wraps after
+// 49.7 days), code, how many more times it recurred right after (merged,
+// saturating), and an argument.
+struct LogEntry {
+  std::uint32_t time_ms = 0;
+  FaultCode code = FaultCode::none;
+  std::uint8_t repeats = 0;
+  std::uint16_t arg = 0;
+  friend bool operator==(const LogEntry&, const LogEntry&) = default;
+};
+
+// get_log response: the oldest entries not read yet (at most 6), which the
+// response then removes from the device's log; `dropped` counts entries lost
+// to a full log since the last read, `more` that entries remain.
+struct FaultLog {
+  static constexpr std::size_t kMaxEntries = 6;
+  static constexpr std::size_t kEntrySize = 8;  // u32 time_ms, u8 code, u8 repeats, u16 arg
+  static constexpr std::size_t kWireSize = 4 + kMaxEntries * kEntrySize;
+  std::uint8_t count = 0;
+  std::uint8_t more = 0;  // 1 if the device holds further entries
+  std::uint16_t dropped = 0;
+  std::array<LogEntry, kMaxEntries> entries{};
+
+  void write(ByteWriter& w) const;
+  Error read(ByteReader& r);
+  friend bool operator==(const FaultLog&, const FaultLog&) = default;
 };
 
 // Builds a request or response carrying a typed payload.
@@ -246,10 +317,21 @@ inline Response make_response(const Request& req, Status status) {
   return r;
 }
 
+// The shortest payload a decoder accepts: the minor-0 size where a later
+// minor appended fields.
+template <class Payload>
+constexpr std::size_t min_wire_size() {
+  if constexpr (requires { Payload::kMinWireSize; }) {
+    return Payload::kMinWireSize;
+  } else {
+    return Payload::kWireSize;
+  }
+}
+
 // Reads the typed payload of a request or response.
 template <class Payload, class Message>
 Error read_payload(const Message& msg, Payload& out) {
-  if (msg.length < Payload::kWireSize) return Error::bad_length;
+  if (msg.length < min_wire_size<Payload>()) return Error::bad_length;
   ByteReader r(msg.body());
   Payload p{};
   if (Error e = p.read(r); e != Error::ok) return e;

@@ -9,6 +9,11 @@ namespace tonus::proto {
 // Counts loss, duplication and reordering from 16-bit sequence numbers that
 // wrap. Keeps a 64-message history so that a late message is recognised as
 // reordered (and taken back out of `lost`) or as a duplicate.
+//
+// A sender restart is seen three ways: a change of the stream's boot epoch
+// (any change; 0 = the sender does not say, the version-1.0 behaviour), a
+// jump of more than kResyncThreshold, or a backward step as the first report
+// after note_reconnect(). Each counts one resync and loses nothing.
 class SequenceTracker {
  public:
   enum class Verdict : std::uint8_t {
@@ -18,14 +23,20 @@ class SequenceTracker {
     duplicate,  // already seen
     late,       // older than the newest but not seen before: reordered
     stale,      // older than the history window: dropped, counted in `stale`
-    resync,     // jump too large to be loss (device reset): counting restarts
+    resync,     // a sender restart (new boot epoch, or a jump too large to be loss): counting restarts
   };
 
   // Jumps beyond this are treated as a sender restart rather than loss.
   static constexpr std::uint16_t kResyncThreshold = 4096;
   static constexpr unsigned kWindow = 64;
 
-  Verdict push(std::uint16_t seq);
+  // boot_epoch: the stream's byte 3 (0 = unknown).
+  Verdict push(std::uint16_t seq, std::uint8_t boot_epoch = 0);
+  // The link was reopened: the sender may have rebooted with the same (or no)
+  // epoch, so the next report restarts counting if it is not ahead.
+  void note_reconnect() { reconnected_ = true; }
+  // The sender restarted, known by other means (a CAN heartbeat whose uptime went back).
+  void note_restart();
 
   [[nodiscard]] std::uint64_t received() const { return received_; }
   [[nodiscard]] std::uint64_t lost() const { return lost_; }
@@ -36,7 +47,11 @@ class SequenceTracker {
   [[nodiscard]] std::uint16_t newest() const { return newest_; }
 
  private:
+  Verdict restart(std::uint16_t seq, std::uint8_t boot_epoch);
+
   bool started_ = false;
+  bool reconnected_ = false;
+  std::uint8_t epoch_ = 0;
   std::uint16_t newest_ = 0;
   std::uint64_t history_ = 0;  // bit k: newest_ - k was received
   std::uint64_t received_ = 0;

@@ -1,7 +1,7 @@
 // Stiffness stream message (device -> host), sent at the report rate (<= 1 kHz).
 //
 // Layout (little-endian), see docs/protocol.md for the byte table:
-//   0 u8 version | 1 u8 group_count | 2 u8 channel_count | 3 u8 reserved
+//   0 u8 version | 1 u8 group_count | 2 u8 channel_count | 3 u8 boot_epoch
 //   4 u16 sequence | 6 u32 device_time_us | 10 u16 status
 //   12 u16 electrode_off | 14 u16 saturation | 16 u16 artifact
 //   18 u16 level[group_count] | ... u16 envelope[channel_count]
@@ -32,6 +32,10 @@ inline constexpr std::size_t kStreamHeaderSize = 18;
 inline constexpr std::uint16_t kLevelMax = 0xFFFF;     // maximal co-contraction
 inline constexpr std::uint16_t kEnvelopeOne = 0x8000;  // envelope == reference (MVC when calibrated)
 
+// boot_epoch 0: the sender does not say (a version-1.0 device, or a binding
+// without room for it, such as CAN).
+inline constexpr std::uint8_t kBootEpochUnknown = 0;
+
 struct StreamMessage {
   std::uint16_t sequence = 0;                           // +1 per report, wraps at 2^16
   std::uint32_t device_time_us = 0;                     // device monotonic clock, wraps at 2^32 us (~71.6 min)
@@ -41,6 +45,7 @@ struct StreamMessage {
   std::uint16_t artifact = 0;                           // bit i: motion artifact on channel i
   std::uint8_t group_count = 4;                         // 1..kMaxGroups
   std::uint8_t channel_count = 8;                       // 1..kMaxChannels
+  std::uint8_t boot_epoch = kBootEpochUnknown;          // differs from the previous boot's; 0 = unknown
   std::array<std::uint16_t, kMaxGroups> levels{};       // 0 relaxed .. 65535 maximal co-contraction
   std::array<std::uint16_t, kMaxChannels> envelopes{};  // Q1.15: 32768 == reference, saturates
 

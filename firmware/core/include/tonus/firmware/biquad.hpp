@@ -32,7 +32,7 @@ double butterworth_q(std::size_t order, std::size_t section);
 
 Biquad design_lowpass(double fs_hz, double fc_hz, double q);
 Biquad design_highpass(double fs_hz, double fc_hz, double q);
-// Notch at f0 with a -3 dB width of bandwidth_hz (Q = f0 / bandwidth).
+// Notch at f0 whose -3 dB points lie exactly bandwidth_hz apart (digital domain).
 Biquad design_notch(double fs_hz, double f0_hz, double bandwidth_hz);
 
 // Analysis (double precision, from the float coefficients actually run).

@@ -9,7 +9,7 @@
 namespace tonus::fw {
 
 inline constexpr std::uint8_t kFirmwareMajor = 0;
-inline constexpr std::uint8_t kFirmwareMinor = 5;
+inline constexpr std::uint8_t kFirmwareMinor = 6;
 inline constexpr std::uint8_t kFirmwarePatch = 0;
 
 inline constexpr std::size_t kChannels = 8;  // 4 antagonist pairs: channel 2p flexor, 2p+1 extensor

@@ -6,7 +6,9 @@
 //              -> low-pass 450 Hz, 4th-order Butterworth (2 biquads), only below Nyquist
 //              -> full-wave rectification
 //              -> linear envelope: one-pole low-pass with time constant tau (default 100 ms)
-//                 or moving RMS over a window of tau
+//                 or moving RMS over a window of tau (displayed, calibrated on)
+//              -> level envelope: the same smoothness in steady effort, a memory
+//                 restarted at each change of effort (level_envelope.hpp)
 //
 // The model (ChainModel) is designed once from the configuration; the data
 // (ChannelState) is preallocated and mutated by chain_step, a pure function of both.
@@ -18,6 +20,7 @@
 
 #include "tonus/firmware/biquad.hpp"
 #include "tonus/firmware/capacity.hpp"
+#include "tonus/firmware/level_envelope.hpp"
 #include "tonus/protocol/payloads.hpp"
 
 namespace tonus::fw {
@@ -43,6 +46,7 @@ struct ChainModel {
   float envelope_alpha = 0.0F;         // one-pole envelope gain: 1 - exp(-1 / (tau fs))
   std::uint32_t rms_slot_samples = 1;  // samples summed per RMS slot
   std::uint32_t rms_slots = 1;         // slots in the RMS window
+  LevelEnvelopeModel level{};          // the levels' envelope (level_envelope.hpp)
 };
 
 // Designs the chain for a configuration that passed proto::check_config.
@@ -60,6 +64,7 @@ struct ChannelState {
   float rms_acc = 0.0F;
   std::uint32_t rms_fill = 0;
   std::uint32_t rms_head = 0;
+  LevelEnvelopeState level{};
 };
 
 // Intermediate signals the quality detectors look at, produced for free by the chain.
@@ -74,6 +79,12 @@ struct ChainTaps {
 float chain_step(const ChainModel& m, ChannelState& s, float x, ChainTaps& taps);
 
 void reset(ChannelState& s);
+
+// The envelope the stiffness levels use (fast after a change of effort, see
+// level_envelope.hpp), in the units of the one chain_step returns.
+inline float level_envelope(const ChainModel& m, const ChannelState& s) {
+  return level_envelope_value(m.level, s.level);
+}
 
 // Latency of the chain as the performer feels it, in seconds.
 struct ChainDelay {

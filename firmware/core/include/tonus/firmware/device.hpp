@@ -15,6 +15,7 @@
 #include "tonus/firmware/calibration.hpp"
 #include "tonus/firmware/capacity.hpp"
 #include "tonus/firmware/chain.hpp"
+#include "tonus/firmware/fault_log.hpp"
 #include "tonus/firmware/levels.hpp"
 #include "tonus/firmware/nv_record.hpp"
 #include "tonus/firmware/quality.hpp"
@@ -31,6 +32,9 @@ inline constexpr std::uint32_t kHeartbeatPeriodUs = 1000000;
 // once; if that does not bring blocks back the band reports a fault and stops
 // kicking the watchdog, so the chip resets.
 inline constexpr std::uint64_t kSamplerStallUs = 200000;
+// The longest a reset waits for its own answer to leave (HID: the host's next
+// 1 ms poll; CAN: 64 queued frames take about 8 ms at 1 Mbit/s).
+inline constexpr std::uint64_t kResetDrainUs = 50000;
 
 // Which transport a command came in on; its response goes back the same way.
 enum class Link : std::uint8_t { hid, can };
@@ -74,6 +78,8 @@ class Device {
   // The sampler delivered nothing for kSamplerStallUs even after a restart.
   [[nodiscard]] bool sampler_stalled() const { return sampler_stalled_; }
   [[nodiscard]] const Calibrator& calibrator() const { return calibrator_; }
+  [[nodiscard]] std::uint32_t boot_count() const { return boot_count_; }
+  [[nodiscard]] const FaultLog& fault_log() const { return faults_; }
 
  private:
   void apply_config(const proto::DeviceConfig& cfg, bool restart_sampler);
@@ -85,8 +91,11 @@ class Device {
   void poll_can();
   void receive(std::span<const std::uint8_t> message, Link link, std::uint64_t rx_us);
   // Sends a response; over CAN from `can_node`.
-  void reply(const proto::Response& rsp, Link link, std::uint8_t can_node);
+  void reply(const proto::Response& rsp, Link link, std::uint8_t can_node, std::uint32_t can_id_base);
   void after_reply(Link link);
+  void reboot_when_drained(std::uint64_t now_us);
+  void fault(proto::FaultCode code, std::uint16_t arg);
+  [[nodiscard]] std::uint8_t boot_epoch() const;
   void send_heartbeat(std::uint64_t now_us);
   void update_led();
 
@@ -125,7 +134,13 @@ class Device {
   LoadResult load_result_ = LoadResult::empty;
   std::uint64_t next_heartbeat_us_ = 0;
   proto::can::Reassembler can_requests_{proto::can::Function::request, 1};
-  bool reset_pending_ = false;
+  bool reset_pending_ = false;           // a `reset` was answered: reboot once the answer has left
+  bool reset_issued_ = false;            // SystemControl::reset() called (the sim returns from it)
+  std::uint64_t reset_deadline_us_ = 0;  // reboot anyway after this (a host that stopped polling)
+  bool to_bootloader_ = false;           // the pending reboot goes to the update bootloader
+  std::uint32_t boot_count_ = 0;         // 0: unknown (the storage holds no record of ours)
+  proto::ResetCause reset_cause_ = proto::ResetCause::unknown;
+  FaultLog faults_{};
   ReportObserver observer_ = nullptr;
   void* observer_context_ = nullptr;
   proto::ResetKind reset_kind_ = proto::ResetKind::reboot;

@@ -1,15 +1,20 @@
 // The persisted state of the band (configuration + calibration) and its
-// append-only log in flash-like storage.
+// record log in flash-like storage of two (or more) erase sectors.
 //
-// Record (little-endian, 128-byte slots):
+// Record version 2 (little-endian, 256-byte slots):
 //   u32 magic 'TNUS' | u8 version | u8 payload length | payload | u16 CRC-16/CCITT-FALSE
-//   payload = DeviceConfig (protocol wire form) | baseline f32[8] | reference f32[8]
-//             | cocontraction f32[4] | u16 baseline_mask | u16 reference_mask | u8 cocontraction_mask
-// Saving appends a record in the next erased slot (erasing the area only when
-// it is full: one erase per 128 saves). Loading takes the last slot whose
-// magic, version, length, CRC and configuration check out; a torn or corrupt
-// newest record therefore falls back to the one before, and no valid record
-// at all falls back to defaults (reported as "not calibrated").
+//   payload = u32 generation | u8 config length | DeviceConfig (protocol wire form) | baseline f32[8]
+//             | reference f32[8] | cocontraction f32[4] | u16 baseline_mask
+//             | u16 reference_mask | u8 cocontraction_mask | u32 boot_count
+// Version 1 (128-byte slots, no generation) is still read, as generation 0.
+//
+// Saving appends the next generation to the sector that holds the newest
+// record. When that sector is full, the other one is erased and the record
+// goes to its first slot: the newest copy is never erased before a newer one
+// is written and verified, so a power cut at any instant leaves a valid record
+// (the new one, or the one before). Loading takes the valid record with the
+// highest generation in any sector; a torn or corrupt record is skipped, and
+// no valid record at all gives defaults (reported as "not calibrated").
 #pragma once
 
 #include <cstddef>
@@ -23,12 +28,15 @@
 namespace tonus::fw {
 
 inline constexpr std::uint32_t kRecordMagic = 0x53554E54;  // "TNUS"
-inline constexpr std::uint8_t kRecordVersion = 1;
-inline constexpr std::size_t kRecordSlot = 128;
+inline constexpr std::uint8_t kRecordVersion = 2;
+inline constexpr std::size_t kRecordSlot = 256;
+inline constexpr std::uint8_t kRecordVersion1 = 1;  // read only
+inline constexpr std::size_t kRecordSlot1 = 128;
 
 struct Persisted {
   proto::DeviceConfig config{};
   Calibration calibration{};
+  std::uint32_t boot_count = 0;  // boots since the storage was erased (version 2 only)
   friend bool operator==(const Persisted&, const Persisted&) = default;
 };
 
@@ -43,15 +51,16 @@ enum class LoadResult : std::uint8_t {
 const char* to_string(LoadResult r);
 
 // Serialises one record into a slot buffer; returns its size (<= kRecordSlot).
-std::size_t encode_record(const Persisted& p, std::span<std::uint8_t, kRecordSlot> out);
-// Checks and reads one slot. group_count / front end are used to re-check the configuration.
-LoadResult decode_record(std::span<const std::uint8_t, kRecordSlot> slot, Persisted& out);
+std::size_t encode_record(const Persisted& p, std::uint32_t generation, std::span<std::uint8_t, kRecordSlot> out);
+// Checks and reads one record at the front of `slot` (version 2, or version 1
+// with generation 0).
+LoadResult decode_record(std::span<const std::uint8_t> slot, Persisted& out, std::uint32_t& generation);
 
 // Loads the newest valid record; `out` is left untouched unless it returns loaded.
 LoadResult load_persisted(hal::Storage& storage, Persisted& out);
-// Appends a record and verifies it by reading it back.
+// Writes the next generation and verifies it by reading it back.
 bool save_persisted(hal::Storage& storage, const Persisted& p);
-// Erases the area (factory defaults).
+// Erases every sector (factory defaults).
 bool erase_persisted(hal::Storage& storage);
 
 }  // namespace tonus::fw

@@ -29,6 +29,7 @@ enum class Scenario : std::uint8_t {
   hum,       // rest with strong mains hum on every channel (electrodes on, poor reference)
   dropout,   // channel 3 stuck at the high rail (broken lead) from 25 % on
   selftest,  // short mixed pattern for the on-target self-test
+  step,      // co-contraction step on every channel at half the duration: step_from, then step_activation
 };
 
 const char* to_string(Scenario s);
@@ -54,7 +55,14 @@ struct SynthSpec {
   float hum_counts = 3.0F;        // hum amplitude with electrodes on
   float noise_rms_counts = 4.0F;  // amplifier + electrode noise
   float mvc_rms_counts = 300.0F;  // EMG RMS at activation 1 (before the per-channel gain)
+  float step_from = 0.0F;         // Scenario::step: the effort before the step (0: rest)
+  float step_activation = 0.5F;   // Scenario::step: the effort after the step
 };
+
+// Scenario::step: the first frame of the new effort (half the duration, rounded down).
+inline std::size_t step_frame(const SynthSpec& spec) {
+  return static_cast<std::size_t>(spec.seconds * spec.sample_rate_hz) / 2;
+}
 
 // Deterministic xorshift64* generator.
 class Rng {

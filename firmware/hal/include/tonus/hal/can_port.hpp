@@ -12,6 +12,8 @@ class CanPort {
   virtual bool send(const proto::CanFrame& frame) = 0;
   // Takes one received frame; false if none.
   virtual bool receive(proto::CanFrame& frame) = 0;
+  // Every queued frame has left (the transmit queue and mailboxes are empty).
+  [[nodiscard]] virtual bool idle() const = 0;
 
  protected:
   ~CanPort() = default;

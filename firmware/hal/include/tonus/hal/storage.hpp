@@ -1,6 +1,7 @@
-// HAL: non-volatile storage with flash semantics: erase sets the whole area
-// to 0xFF, program may only write bytes that are erased. On the band this is
-// one 16 KiB flash sector; the core keeps an append-only record log in it.
+// HAL: non-volatile storage with flash semantics, in equal erase sectors:
+// erasing a sector sets it to 0xFF, program may only clear bits. On the band
+// these are two 16 KiB flash sectors; the core keeps its record log in them so
+// that one sector always holds a valid copy while the other is erased.
 #pragma once
 
 #include <cstddef>
@@ -11,9 +12,12 @@ namespace tonus::hal {
 
 class Storage {
  public:
-  [[nodiscard]] virtual std::size_t size() const = 0;
+  [[nodiscard]] virtual std::size_t sector_size() const = 0;
+  [[nodiscard]] virtual std::size_t sector_count() const = 0;
+  [[nodiscard]] std::size_t size() const { return sector_size() * sector_count(); }
+  // Offsets run over the whole area: sector s starts at s * sector_size().
   virtual bool read(std::size_t offset, std::span<std::uint8_t> out) = 0;
-  virtual bool erase() = 0;
+  virtual bool erase(std::size_t sector) = 0;
   virtual bool program(std::size_t offset, std::span<const std::uint8_t> data) = 0;
 
  protected:

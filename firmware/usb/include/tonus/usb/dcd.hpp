@@ -33,6 +33,11 @@ class Dcd {
   // Starts one IN transfer on EP1, copying the packet (into the TX FIFO) before
   // returning; false while the previous one is still in flight.
   virtual bool hid_send(std::span<const std::uint8_t> packet) = 0;
+  // An IN packet is loaded and the host has not taken it yet.
+  [[nodiscard]] virtual bool hid_busy() const = 0;
+  // Sets or clears ENDPOINT_HALT on EP1 IN (`in`) or OUT. Clearing resets the
+  // endpoint's data toggle to DATA0 (USB 2.0 9.4.5).
+  virtual void hid_halt(bool in, bool halt) = 0;
 
  protected:
   ~Dcd() = default;
