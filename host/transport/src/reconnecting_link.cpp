@@ -76,11 +76,11 @@ ReconnectingBandLink::Opener hidapi_opener(std::uint16_t vid, std::uint16_t pid,
   };
 }
 
-ReconnectingBandLink::Opener socketcan_opener(std::string iface, std::uint8_t node) {
-  return [iface = std::move(iface), node](std::string& error) -> std::unique_ptr<BandLink> {
-    auto t = SocketCanTransport::open(iface, node, error);
+ReconnectingBandLink::Opener socketcan_opener(std::string iface, std::uint8_t node, std::uint32_t id_base) {
+  return [iface = std::move(iface), node, id_base](std::string& error) -> std::unique_ptr<BandLink> {
+    auto t = SocketCanTransport::open(iface, node, error, id_base);
     if (t == nullptr) return nullptr;
-    return std::make_unique<CanBandLink>(std::move(t), node);
+    return std::make_unique<CanBandLink>(std::move(t), node, id_base);
   };
 }
 
@@ -92,11 +92,11 @@ ReconnectingBandLink::Opener seqpacket_hid_opener(std::string path) {
   };
 }
 
-ReconnectingBandLink::Opener seqpacket_can_opener(std::string path, std::uint8_t node) {
-  return [path = std::move(path), node](std::string& error) -> std::unique_ptr<BandLink> {
+ReconnectingBandLink::Opener seqpacket_can_opener(std::string path, std::uint8_t node, std::uint32_t id_base) {
+  return [path = std::move(path), node, id_base](std::string& error) -> std::unique_ptr<BandLink> {
     auto t = SeqpacketCanTransport::connect(path, error);
     if (t == nullptr) return nullptr;
-    return std::make_unique<CanBandLink>(std::move(t), node);
+    return std::make_unique<CanBandLink>(std::move(t), node, id_base);
   };
 }
 

@@ -63,9 +63,10 @@ class ReconnectingBandLink final : public BandLink {
 // attempt, so a band replugged on another hidraw node is found again.
 ReconnectingBandLink::Opener hidapi_opener(std::uint16_t vid, std::uint16_t pid, std::wstring serial = {},
                                            HidBackend& backend = hidapi_backend());
-ReconnectingBandLink::Opener socketcan_opener(std::string iface, std::uint8_t node);
+// `id_base`: the band's DeviceConfig.can_id_base (0 = the 11-bit id plan).
+ReconnectingBandLink::Opener socketcan_opener(std::string iface, std::uint8_t node, std::uint32_t id_base = 0);
 // tonus-band-sim --hid-socket PATH / --can-socket PATH.
 ReconnectingBandLink::Opener seqpacket_hid_opener(std::string path);
-ReconnectingBandLink::Opener seqpacket_can_opener(std::string path, std::uint8_t node);
+ReconnectingBandLink::Opener seqpacket_can_opener(std::string path, std::uint8_t node, std::uint32_t id_base = 0);
 
 }  // namespace tonus::host
