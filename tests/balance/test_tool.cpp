@@ -7,8 +7,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <sstream>
 #include <string>
+#include "support/read_file.hpp"
+
+using tonus::test::read_file;
 
 namespace {
 
@@ -29,13 +31,6 @@ Run run(const std::string& args) {
   return r;
 }
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 std::string temp(const std::string& name) { return std::string(TONUS_TEST_TMP) + "/" + name; }
 
 }  // namespace
@@ -48,21 +43,21 @@ TEST_CASE("tonus zmp: corrects the bundled walk and writes BVH, CSV, JSON and SV
   CHECK(r.code == 0);
   CHECK(r.out.find("before: ZMP outside") != std::string::npos);
   CHECK(r.out.find("T-pose") != std::string::npos);
-  const std::string json = slurp(temp("walk.json"));
+  const std::string json = read_file(temp("walk.json"));
   for (const char* key : {"\"frames\"", "\"frames_outside_before\"", "\"frames_outside_after\": 0,",
                           "\"max_outside_before_m\"", "\"max_outside_after_m\"", "\"max_foot_displacement_m\"",
                           "\"rms_joint_change_rad\"", "\"frames_unsolved\": 0,", "\"frames_airborne\""}) {
     CHECK_MESSAGE(json.find(key) != std::string::npos, key);
   }
-  const std::string csv = slurp(temp("walk.csv"));
+  const std::string csv = read_file(temp("walk.csv"));
   CHECK(csv.rfind("frame,time_s,", 0) == 0);
   CHECK(std::count(csv.begin(), csv.end(), '\n') == 345);  // header + 344 frames
-  const std::string svg = slurp(temp("walk.svg"));
+  const std::string svg = read_file(temp("walk.svg"));
   CHECK(svg.find("<svg") == 0);
   CHECK(svg.find("polyline") != std::string::npos);
   // The written clip reads back and is balanced: analysing it again finds nothing to correct.
   const Run again = run(temp("walk.bvh") + " --json " + temp("again.json") + " --unit cmu");
-  CHECK(slurp(temp("again.json")).find("\"frames_outside_before\": 0,") != std::string::npos);
+  CHECK(read_file(temp("again.json")).find("\"frames_outside_before\": 0,") != std::string::npos);
 }
 
 TEST_CASE("tonus zmp: bad input is refused with exit code 2 and a reason") {

@@ -10,22 +10,14 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <regex>
-#include <sstream>
 #include <string>
 #include <vector>
+#include "support/read_file.hpp"
 
-namespace {
+using tonus::test::read_file;
 
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-}  // namespace
+namespace {}  // namespace
 
 TEST_CASE("the band image boots in QEMU and runs its main loop") {
   const std::string elf = TONUS_BAND_ELF;

@@ -12,12 +12,12 @@
 #include <array>
 #include <chrono>
 #include <cstdint>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "summary.hpp"
+#include "support/read_file.hpp"
 #include "tonus/protocol/can.hpp"
 #include "tonus/protocol/hid.hpp"
 #include "tonus/protocol/payloads.hpp"
@@ -61,13 +61,6 @@ double json_number(const std::string& text, const std::string& key) {
   return v;
 }
 
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 std::uint64_t host_now_us() {
   return static_cast<std::uint64_t>(
       std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now().time_since_epoch())
@@ -105,7 +98,7 @@ TEST_CASE("tonus-band-sim --synthetic step writes the step-to-level latency, 90 
   const pid_t pid = spawn_sim({"--synthetic", "step", "--seconds", "2", "--fast", "--quiet", "--json", json});
   REQUIRE(pid > 0);
   REQUIRE(wait_exit(pid) == 0);
-  const std::string text = read_file(json);
+  const std::string text = test::read_file(json);
   ::unlink(json.c_str());
   const double l10 = json_number(text, "level_latency_10_ms"), l50 = json_number(text, "level_latency_50_ms"),
                l90 = json_number(text, "level_latency_90_ms");
@@ -118,7 +111,7 @@ TEST_CASE("tonus-band-sim --synthetic step writes the step-to-level latency, 90 
   // Another scenario has no step: the fields are null.
   const pid_t rest = spawn_sim({"--synthetic", "rest", "--seconds", "0.5", "--fast", "--quiet", "--json", json});
   REQUIRE(wait_exit(rest) == 0);
-  const std::string text2 = read_file(json);
+  const std::string text2 = test::read_file(json);
   ::unlink(json.c_str());
   CHECK(text2.find("\"level_latency_90_ms\": null") != std::string::npos);
 }

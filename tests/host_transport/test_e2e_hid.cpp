@@ -5,10 +5,9 @@
 #include <sys/socket.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "sim_process.hpp"
+#include "support/read_file.hpp"
 #include "tonus/host/transport/band_link.hpp"
 #include "tonus/protocol/hid.hpp"
 #include "tonus/protocol/payloads.hpp"
@@ -183,12 +182,7 @@ TEST_CASE("the host disappearing mid-calibration: the band neither hangs nor wri
   test::SimProcess sim(
       {"--synthetic", "rest", "--seconds", "30", "--fast", "--quiet", "--hid-fd", "3", "--storage", storage});
   REQUIRE(sim.started());
-  const auto contents = [&storage] {
-    std::ifstream in(storage, std::ios::binary);
-    std::ostringstream out;
-    out << in.rdbuf();
-    return out.str();
-  };
+  const auto contents = [&storage] { return test::read_file(storage); };
   std::string at_boot;
   {
     host::SeqpacketHidTransport transport(sim.take_hid());

@@ -5,19 +5,14 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <regex>
 #include <sstream>
 #include <string>
+#include "support/read_file.hpp"
+
+using tonus::test::read_file;
 
 namespace {
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 // The text of "key": <value> (array, object or scalar) in a flat JSON file.
 std::string field(const std::string& json, const std::string& key) {
@@ -44,7 +39,7 @@ TEST_CASE("sim CLI: rest, ramp and faults scenarios and their JSON summaries") {
       (std::filesystem::temp_directory_path() / ("tonus-sim-" + std::to_string(::getpid()) + ".json")).string();
 
   std::string out = run_sim("--synthetic rest --seconds 3 --fast", json);
-  std::string j = slurp(json);
+  std::string j = read_file(json);
   const int rate_hz = std::stoi(field(j, "report_rate_hz"));  // the default report rate
   CHECK(rate_hz > 0);
   CHECK(out.find("reports " + std::to_string(3 * rate_hz)) != std::string::npos);
@@ -55,7 +50,7 @@ TEST_CASE("sim CLI: rest, ramp and faults scenarios and their JSON summaries") {
         "{\"electrode_off\": [], \"saturation\": [], \"artifact\": [], \"block_lost\": false}");
 
   run_sim("--synthetic ramp --seconds 5 --fast --seed 4", json);
-  j = slurp(json);
+  j = read_file(json);
   CHECK(field(j, "levels_min") == "[0, 0, 0, 0]");
   // Uncalibrated, so the top depends on each channel's gain; every group nearly saturates.
   std::stringstream maxima(field(j, "levels_max").substr(1));
@@ -67,7 +62,7 @@ TEST_CASE("sim CLI: rest, ramp and faults scenarios and their JSON summaries") {
   CHECK(groups == 4);
 
   out = run_sim("--synthetic faults --seconds 5 --fast", json);
-  j = slurp(json);
+  j = read_file(json);
   CHECK(field(j, "lost_blocks") == "1");
   CHECK(field(j, "reports") == std::to_string(5 * rate_hz - 1));  // the lost 1 ms block cost one report
   CHECK(field(j, "sequence_continuous") == "true");
@@ -77,7 +72,7 @@ TEST_CASE("sim CLI: rest, ramp and faults scenarios and their JSON summaries") {
 
   // Same seed, same run: the summary is reproducible byte for byte.
   run_sim("--synthetic faults --seconds 5 --fast", json + ".2");
-  CHECK(slurp(json) == slurp(json + ".2"));
+  CHECK(read_file(json) == read_file(json + ".2"));
   std::filesystem::remove(json);
   std::filesystem::remove(json + ".2");
 }

@@ -8,21 +8,14 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
-#include <sstream>
 #include <string>
 
+#include "support/read_file.hpp"
 #include "tonus/usb/descriptors.hpp"
 
-namespace {
+using tonus::test::read_file;
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-}  // namespace
+namespace {}  // namespace
 
 TEST_CASE("udev rule: matches the band's hidraw node by the firmware's VID:PID") {
   std::ifstream in(TONUS_UDEV_DIR "/70-tonus-band.rules");
@@ -51,7 +44,7 @@ TEST_CASE("udev rule: the install script puts it under rules.d") {
   const std::string cmd = "DESTDIR=" + root.string() + " sh " TONUS_UDEV_DIR "/install.sh >/dev/null";
   REQUIRE(std::system(cmd.c_str()) == 0);
   const auto installed = root / "etc/udev/rules.d/70-tonus-band.rules";
-  CHECK(slurp(installed.string()) == slurp(TONUS_UDEV_DIR "/70-tonus-band.rules"));
+  CHECK(read_file(installed.string()) == read_file(TONUS_UDEV_DIR "/70-tonus-band.rules"));
   CHECK((std::filesystem::status(installed).permissions() & std::filesystem::perms::others_write) ==
         std::filesystem::perms::none);
   std::filesystem::remove_all(root);
