@@ -9,10 +9,13 @@
 
 #include <chrono>
 #include <csignal>
+#include <memory>
 #include <string>
 #include <thread>
 #include <utility>
 #include <vector>
+
+#include "tonus/host/transport/hid_transport.hpp"
 
 extern char** environ;
 
@@ -80,5 +83,16 @@ class SimProcess {
   bool reaped_ = false;
   int hid_fd_ = -1, can_fd_ = -1;
 };
+
+// Connects to a simulator's listening HID socket (--hid-socket), retrying for
+// up to 2 s while the simulator starts; nullptr and `error` if it never came.
+inline std::unique_ptr<host::SeqpacketHidTransport> connect_hid(const std::string& path, std::string& error) {
+  std::unique_ptr<host::SeqpacketHidTransport> t;
+  for (int k = 0; k < 200 && !t; ++k) {
+    t = host::SeqpacketHidTransport::connect(path, error);
+    if (!t) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return t;
+}
 
 }  // namespace tonus::test

@@ -147,12 +147,8 @@ TEST_CASE("HID link over a listening socket in real time") {
       (std::filesystem::temp_directory_path() / ("tonus-hid-" + std::to_string(::getpid()) + ".sock")).string();
   test::SimProcess sim({"--synthetic", "rest", "--seconds", "1.5", "--quiet", "--hid-socket", path});
   REQUIRE(sim.started());
-  std::unique_ptr<host::SeqpacketHidTransport> t;
   std::string error;
-  for (int k = 0; k < 200 && !t; ++k) {
-    t = host::SeqpacketHidTransport::connect(path, error);
-    if (!t) std::this_thread::sleep_for(10ms);
-  }
+  const std::unique_ptr<host::SeqpacketHidTransport> t = test::connect_hid(path, error);
   REQUIRE_MESSAGE(t, error);
   host::HidBandLink link(*t);
   std::uint64_t reports = 0;

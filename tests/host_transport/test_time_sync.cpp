@@ -105,12 +105,8 @@ TEST_CASE("time sync against tonus-band-sim in real time: error under 1 ms, meas
   test::SimProcess sim({"--synthetic", "rest", "--seconds", "8", "--quiet", "--hid-socket", path, "--clock-offset-us",
                         std::to_string(X), "--clock-drift-ppm", std::to_string(drift_ppm)});
   REQUIRE(sim.started());
-  std::unique_ptr<host::SeqpacketHidTransport> t;
   std::string error;
-  for (int k = 0; k < 200 && !t; ++k) {
-    t = host::SeqpacketHidTransport::connect(path, error);
-    if (!t) std::this_thread::sleep_for(10ms);
-  }
+  const std::unique_ptr<host::SeqpacketHidTransport> t = test::connect_hid(path, error);
   REQUIRE_MESSAGE(t, error);
   host::HidBandLink link(*t);
   host::ClockSync sync;
