@@ -57,6 +57,33 @@ SynthSpec spec(Scenario s, float seconds) {
   return sp;
 }
 
+// Sends `req` over CAN to node `to` at `id_base`, runs two 1 ms blocks, and
+// returns the response reassembled from node `from` at the same base, if any.
+std::optional<proto::Response> ask_can(Bench& b, Device& dev, const proto::Request& req, std::uint8_t to,
+                                       std::uint8_t from, std::uint32_t id_base = 0) {
+  std::array<std::uint8_t, proto::kMaxMessageSize> bytes{};
+  std::size_t n = 0;
+  REQUIRE(proto::encode_request(req, bytes, n) == proto::Error::ok);
+  std::array<proto::CanFrame, proto::can::kMaxSegments> frames{};
+  std::size_t count = 0;
+  REQUIRE(proto::can::segment(std::span<const std::uint8_t>(bytes).first(n), proto::can::Function::request, to, frames,
+                              count, id_base) == proto::Error::ok);
+  for (std::size_t k = 0; k < count; ++k) b.can.inbox.push_back(frames[k]);
+  b.can.sent.clear();
+  b.step(dev);
+  b.step(dev);
+  proto::can::Reassembler reasm(proto::can::Function::response, from, id_base);
+  std::optional<proto::Response> out;
+  for (const proto::CanFrame& f : b.can.sent) {
+    bool complete = false;
+    if (reasm.push(f, complete) != proto::Error::ok || !complete) continue;
+    proto::Response rsp{};
+    REQUIRE(proto::decode_response(reasm.message(), rsp) == proto::Error::ok);
+    out = rsp;
+  }
+  return out;
+}
+
 }  // namespace
 
 TEST_CASE("boot on empty storage: defaults, not calibrated") {
@@ -529,41 +556,18 @@ TEST_CASE("CAN: a set_config that changes the node id is answered from the old i
   b.run_for(dev, 0.05F);
   const std::uint8_t old_id = dev.config().can_node_id;
   const std::uint8_t new_id = static_cast<std::uint8_t>(old_id == 7 ? 8 : 7);  // ids run 0..31
-  // Sends `req` over CAN to `to`; returns the response reassembled on `from`, if any.
-  const auto ask_can = [&](const proto::Request& req, std::uint8_t to, std::uint8_t from) {
-    std::array<std::uint8_t, proto::kMaxMessageSize> bytes{};
-    std::size_t n = 0;
-    REQUIRE(proto::encode_request(req, bytes, n) == proto::Error::ok);
-    std::array<proto::CanFrame, proto::can::kMaxSegments> frames{};
-    std::size_t count = 0;
-    REQUIRE(proto::can::segment(std::span<const std::uint8_t>(bytes).first(n), proto::can::Function::request, to,
-                                frames, count) == proto::Error::ok);
-    for (std::size_t k = 0; k < count; ++k) b.can.inbox.push_back(frames[k]);
-    b.can.sent.clear();
-    b.step(dev);
-    proto::can::Reassembler reasm(proto::can::Function::response, from);
-    std::optional<proto::Response> out;
-    for (const proto::CanFrame& f : b.can.sent) {
-      bool complete = false;
-      if (reasm.push(f, complete) != proto::Error::ok || !complete) continue;
-      proto::Response rsp{};
-      REQUIRE(proto::decode_response(reasm.message(), rsp) == proto::Error::ok);
-      out = rsp;
-    }
-    return out;
-  };
   proto::DeviceConfig cfg = dev.config();
   cfg.can_node_id = new_id;
-  const auto answer = ask_can(request(proto::Opcode::set_config, 9, cfg), old_id, old_id);
+  const auto answer = ask_can(b, dev, request(proto::Opcode::set_config, 9, cfg), old_id, old_id);
   REQUIRE(answer.has_value());  // before the fix it came from the new id: the host waiting on the old one timed out
   CHECK(answer->token == 9);
   CHECK(answer->status == proto::Status::ok);
   CHECK(dev.config().can_node_id == new_id);
   // From now on the device listens and answers on the new id only.
-  const auto next = ask_can(proto::make_request(proto::Opcode::get_config, 10), new_id, new_id);
+  const auto next = ask_can(b, dev, proto::make_request(proto::Opcode::get_config, 10), new_id, new_id);
   REQUIRE(next.has_value());
   CHECK(next->token == 10);
-  CHECK_FALSE(ask_can(proto::make_request(proto::Opcode::get_config, 11), old_id, old_id).has_value());
+  CHECK_FALSE(ask_can(b, dev, proto::make_request(proto::Opcode::get_config, 11), old_id, old_id).has_value());
 }
 
 TEST_CASE("CAN id base: a band moved off the CANopen ids answers on the old plan, then streams on 29-bit ids") {
@@ -574,36 +578,13 @@ TEST_CASE("CAN id base: a band moved off the CANopen ids answers on the old plan
   b.run_for(dev, 0.05F);
   constexpr std::uint32_t kBase = 0x1A000000;
   const std::uint8_t node = dev.config().can_node_id;
-  const auto ask_can = [&](const proto::Request& req, std::uint32_t base) {
-    std::array<std::uint8_t, proto::kMaxMessageSize> bytes{};
-    std::size_t n = 0;
-    REQUIRE(proto::encode_request(req, bytes, n) == proto::Error::ok);
-    std::array<proto::CanFrame, proto::can::kMaxSegments> frames{};
-    std::size_t count = 0;
-    REQUIRE(proto::can::segment(std::span<const std::uint8_t>(bytes).first(n), proto::can::Function::request, node,
-                                frames, count, base) == proto::Error::ok);
-    for (std::size_t k = 0; k < count; ++k) b.can.inbox.push_back(frames[k]);
-    b.can.sent.clear();
-    b.step(dev);
-    b.step(dev);
-    proto::can::Reassembler reasm(proto::can::Function::response, node, base);
-    std::optional<proto::Response> out;
-    for (const proto::CanFrame& f : b.can.sent) {
-      bool complete = false;
-      if (reasm.push(f, complete) != proto::Error::ok || !complete) continue;
-      proto::Response rsp{};
-      REQUIRE(proto::decode_response(reasm.message(), rsp) == proto::Error::ok);
-      out = rsp;
-    }
-    return out;
-  };
   proto::DeviceConfig cfg = dev.config();
   cfg.can_id_base = kBase + 1;  // not a multiple of 0x800: refused, nothing changes
-  const auto refused = ask_can(request(proto::Opcode::set_config, 1, cfg), 0);
+  const auto refused = ask_can(b, dev, request(proto::Opcode::set_config, 1, cfg), node, node, 0);
   REQUIRE(refused.has_value());
   CHECK(refused->status == proto::Status::bad_value);
   cfg.can_id_base = kBase;
-  const auto answer = ask_can(request(proto::Opcode::set_config, 2, cfg), 0);
+  const auto answer = ask_can(b, dev, request(proto::Opcode::set_config, 2, cfg), node, node, 0);
   REQUIRE(answer.has_value());  // answered on the 11-bit plan the request came on
   CHECK(answer->status == proto::Status::ok);
   // Now every frame is extended at the base: none may use an 11-bit (CANopen) id.
@@ -622,12 +603,13 @@ TEST_CASE("CAN id base: a band moved off the CANopen ids answers on the old plan
   }
   CHECK(cycles >= 540);
   CHECK(heartbeats == 1);
-  const auto next = ask_can(proto::make_request(proto::Opcode::get_config, 3), kBase);
+  const auto next = ask_can(b, dev, proto::make_request(proto::Opcode::get_config, 3), node, node, kBase);
   REQUIRE(next.has_value());
   proto::DeviceConfig back{};
   REQUIRE(proto::read_payload(*next, back) == proto::Error::ok);
   CHECK(back.can_id_base == kBase);
-  CHECK_FALSE(ask_can(proto::make_request(proto::Opcode::get_config, 4), 0).has_value());  // the old plan is gone
+  CHECK_FALSE(ask_can(b, dev, proto::make_request(proto::Opcode::get_config, 4), node, node, 0)
+                  .has_value());  // the old plan is gone
 }
 
 TEST_CASE("a stalled sampler is restarted once, then reported as a fault and the watchdog left to reset the chip") {
