@@ -11,9 +11,11 @@
 #include "fake_board.hpp"
 #include "tonus/protocol/hid_descriptor.hpp"
 #include "tonus/usb/device_core.hpp"
+#include "usb_setup.hpp"
 
 using namespace tonus;
 using namespace tonus::usb;
+using tonus::test::setup_packet;
 
 namespace {
 
@@ -79,18 +81,6 @@ struct FakeDcd final : Dcd {
   }
 };
 
-std::array<std::uint8_t, 8> setup(std::uint8_t type, std::uint8_t req, std::uint16_t value, std::uint16_t index,
-                                  std::uint16_t length) {
-  return {type,
-          req,
-          static_cast<std::uint8_t>(value),
-          static_cast<std::uint8_t>(value >> 8U),
-          static_cast<std::uint8_t>(index),
-          static_cast<std::uint8_t>(index >> 8U),
-          static_cast<std::uint8_t>(length),
-          static_cast<std::uint8_t>(length >> 8U)};
-}
-
 std::string utf16(const std::vector<std::uint8_t>& d) {
   std::string s;
   for (std::size_t k = 2; k + 1 < d.size(); k += 2) s.push_back(static_cast<char>(d[k]));
@@ -99,9 +89,9 @@ std::string utf16(const std::vector<std::uint8_t>& d) {
 
 void enumerate(DeviceCore& core, FakeDcd& dcd) {
   core.on_bus_reset();
-  core.on_setup(setup(0x80, 6, 0x0100, 0, 64));
-  core.on_setup(setup(0x00, 5, 7, 0, 0));
-  core.on_setup(setup(0x00, 9, 1, 0, 0));
+  core.on_setup(setup_packet(0x80, 6, 0x0100, 0, 64));
+  core.on_setup(setup_packet(0x00, 5, 7, 0, 0));
+  core.on_setup(setup_packet(0x00, 9, 1, 0, 0));
   REQUIRE(dcd.hid_open);
 }
 
@@ -146,41 +136,41 @@ TEST_CASE("enumeration as Linux does it") {
   core.on_bus_reset();
   CHECK_FALSE(core.connected());
 
-  core.on_setup(setup(0x80, 6, 0x0100, 0, 64));  // GET_DESCRIPTOR device, 64 bytes asked
+  core.on_setup(setup_packet(0x80, 6, 0x0100, 0, 64));  // GET_DESCRIPTOR device, 64 bytes asked
   CHECK(dcd.last == FakeDcd::Stage::data_in);
   CHECK(dcd.sent == std::vector<std::uint8_t>(kDeviceDescriptor.begin(), kDeviceDescriptor.end()));
   CHECK_FALSE(dcd.zlp);
 
-  core.on_setup(setup(0x00, 5, 7, 0, 0));  // SET_ADDRESS 7
+  core.on_setup(setup_packet(0x00, 5, 7, 0, 0));  // SET_ADDRESS 7
   CHECK(dcd.address == 7);
   CHECK(dcd.status_after_address);
 
-  core.on_setup(setup(0x80, 6, 0x0200, 0, 9));  // configuration header only
+  core.on_setup(setup_packet(0x80, 6, 0x0200, 0, 9));  // configuration header only
   CHECK(dcd.sent.size() == 9);
-  core.on_setup(setup(0x80, 6, 0x0200, 0, 255));
+  core.on_setup(setup_packet(0x80, 6, 0x0200, 0, 255));
   CHECK(dcd.sent.size() == kConfigurationSize);
 
-  core.on_setup(setup(0x80, 6, 0x0300, 0, 255));
+  core.on_setup(setup_packet(0x80, 6, 0x0300, 0, 255));
   CHECK(dcd.sent == std::vector<std::uint8_t>{4, 3, 0x09, 0x04});
-  core.on_setup(setup(0x80, 6, 0x0302, 0x0409, 255));
+  core.on_setup(setup_packet(0x80, 6, 0x0302, 0x0409, 255));
   CHECK(utf16(dcd.sent) == "tonus EMG band");
-  core.on_setup(setup(0x80, 6, 0x0303, 0x0409, 255));
+  core.on_setup(setup_packet(0x80, 6, 0x0303, 0x0409, 255));
   CHECK(utf16(dcd.sent) == "0123456789ABCDEF");
-  core.on_setup(setup(0x80, 6, 0x0309, 0x0409, 255));
-  CHECK(dcd.last == FakeDcd::Stage::stall);      // no such string
-  core.on_setup(setup(0x80, 6, 0x0600, 0, 10));  // device qualifier: full-speed only
+  core.on_setup(setup_packet(0x80, 6, 0x0309, 0x0409, 255));
+  CHECK(dcd.last == FakeDcd::Stage::stall);             // no such string
+  core.on_setup(setup_packet(0x80, 6, 0x0600, 0, 10));  // device qualifier: full-speed only
   CHECK(dcd.last == FakeDcd::Stage::stall);
 
-  core.on_setup(setup(0x00, 9, 1, 0, 0));  // SET_CONFIGURATION 1
+  core.on_setup(setup_packet(0x00, 9, 1, 0, 0));  // SET_CONFIGURATION 1
   CHECK(dcd.last == FakeDcd::Stage::status);
   CHECK(dcd.hid_open);
   CHECK(core.connected());
-  core.on_setup(setup(0x80, 8, 0, 0, 1));
+  core.on_setup(setup_packet(0x80, 8, 0, 0, 1));
   CHECK(dcd.sent == std::vector<std::uint8_t>{1});
 
-  core.on_setup(setup(0x21, 10, 0, 0, 0));  // HID SET_IDLE
+  core.on_setup(setup_packet(0x21, 10, 0, 0, 0));  // HID SET_IDLE
   CHECK(dcd.last == FakeDcd::Stage::status);
-  core.on_setup(setup(0x81, 6, 0x2200, 0, 255));  // report descriptor (interface recipient)
+  core.on_setup(setup_packet(0x81, 6, 0x2200, 0, 255));  // report descriptor (interface recipient)
   CHECK(dcd.sent ==
         std::vector<std::uint8_t>(proto::hid::kReportDescriptor.begin(), proto::hid::kReportDescriptor.end()));
   proto::hid::DescriptorInfo info{};
@@ -196,23 +186,23 @@ TEST_CASE("bad control requests stall; replies never exceed wLength; ZLP when a 
   FakeDcd dcd;
   DeviceCore core(dcd, 1);
   core.on_bus_reset();
-  core.on_setup(setup(0x40, 1, 0, 0, 0));  // vendor request
+  core.on_setup(setup_packet(0x40, 1, 0, 0, 0));  // vendor request
   CHECK(dcd.last == FakeDcd::Stage::stall);
-  core.on_setup(setup(0x00, 9, 2, 0, 0));  // configuration 2 does not exist
+  core.on_setup(setup_packet(0x00, 9, 2, 0, 0));  // configuration 2 does not exist
   CHECK(dcd.last == FakeDcd::Stage::stall);
   CHECK_FALSE(core.connected());
-  core.on_setup(setup(0x00, 5, 200, 0, 0));  // address out of range
+  core.on_setup(setup_packet(0x00, 5, 200, 0, 0));  // address out of range
   CHECK(dcd.last == FakeDcd::Stage::stall);
-  core.on_setup(setup(0x21, 0x55, 0, 0, 0));  // unknown HID request
+  core.on_setup(setup_packet(0x21, 0x55, 0, 0, 0));  // unknown HID request
   CHECK(dcd.last == FakeDcd::Stage::stall);
-  core.on_setup(setup(0x21, 10, 0, 3, 0));  // SET_IDLE to interface 3
+  core.on_setup(setup_packet(0x21, 10, 0, 3, 0));  // SET_IDLE to interface 3
   CHECK(dcd.last == FakeDcd::Stage::stall);
-  core.on_setup(setup(0x80, 6, 0x0100, 0, 8));  // first 8 bytes of the device descriptor
+  core.on_setup(setup_packet(0x80, 6, 0x0100, 0, 8));  // first 8 bytes of the device descriptor
   CHECK(dcd.sent.size() == 8);
-  core.on_setup(setup(0xA1, 1, 0x0101, 0, 100));  // GET_REPORT: 64 bytes < 100 asked, a multiple of 64
+  core.on_setup(setup_packet(0xA1, 1, 0x0101, 0, 100));  // GET_REPORT: 64 bytes < 100 asked, a multiple of 64
   CHECK(dcd.sent.size() == 64);
   CHECK(dcd.zlp);
-  core.on_setup(setup(0x21, 9, 0x0202, 0, 65));  // SET_REPORT longer than a report
+  core.on_setup(setup_packet(0x21, 9, 0x0202, 0, 65));  // SET_REPORT longer than a report
   CHECK(dcd.last == FakeDcd::Stage::stall);
 }
 
@@ -241,7 +231,7 @@ TEST_CASE("HID data path: input reports on EP1, output reports from EP1 OUT or S
   CHECK(r[2] == 0x20);
   CHECK(r[10] == 0);
 
-  core.on_setup(setup(0x21, 9, 0x0202, 0, 64));  // SET_REPORT(output, id 2) through EP0
+  core.on_setup(setup_packet(0x21, 9, 0x0202, 0, 64));  // SET_REPORT(output, id 2) through EP0
   CHECK(dcd.last == FakeDcd::Stage::data_out);
   CHECK(dcd.receive_length == 64);
   std::vector<std::uint8_t> data(64, 0);
@@ -452,25 +442,25 @@ TEST_CASE("ENDPOINT_HALT stalls EP1 until cleared, GET_STATUS reports it, the to
   fw::Device dev(board);
   dev.boot();
   enumerate(u.core, u.dcd);
-  u.core.on_setup(setup(0x02, 3, 0, 0x81, 0));  // SET_FEATURE(ENDPOINT_HALT) on EP1 IN
+  u.core.on_setup(setup_packet(0x02, 3, 0, 0x81, 0));  // SET_FEATURE(ENDPOINT_HALT) on EP1 IN
   CHECK(u.dcd.last == FakeDcd::Stage::status);
   CHECK(u.dcd.in_halt);
-  u.core.on_setup(setup(0x82, 0, 0, 0x81, 2));  // GET_STATUS(endpoint 0x81)
+  u.core.on_setup(setup_packet(0x82, 0, 0, 0x81, 2));  // GET_STATUS(endpoint 0x81)
   CHECK(u.dcd.sent == std::vector<std::uint8_t>{1, 0});
   u.b.run_for(dev, 0.01F);
   CHECK(u.streams().empty());
-  u.core.on_setup(setup(0x02, 1, 0, 0x81, 0));  // CLEAR_FEATURE(ENDPOINT_HALT)
+  u.core.on_setup(setup_packet(0x02, 1, 0, 0x81, 0));  // CLEAR_FEATURE(ENDPOINT_HALT)
   CHECK_FALSE(u.dcd.in_halt);
   CHECK(u.dcd.toggle_resets == 1);
-  u.core.on_setup(setup(0x82, 0, 0, 0x81, 2));
+  u.core.on_setup(setup_packet(0x82, 0, 0, 0x81, 2));
   CHECK(u.dcd.sent == std::vector<std::uint8_t>{0, 0});
   u.b.run_for(dev, 0.01F);
   CHECK(u.streams().size() >= 4);
-  u.core.on_setup(setup(0x02, 3, 0, 0x01, 0));  // EP1 OUT
+  u.core.on_setup(setup_packet(0x02, 3, 0, 0x01, 0));  // EP1 OUT
   CHECK(u.dcd.out_halt);
-  u.core.on_setup(setup(0x02, 3, 0, 0x85, 0));  // no such endpoint
+  u.core.on_setup(setup_packet(0x02, 3, 0, 0x85, 0));  // no such endpoint
   CHECK(u.dcd.last == FakeDcd::Stage::stall);
-  u.core.on_setup(setup(0x00, 3, 1, 0, 0));  // DEVICE_REMOTE_WAKEUP: not supported
+  u.core.on_setup(setup_packet(0x00, 3, 1, 0, 0));  // DEVICE_REMOTE_WAKEUP: not supported
   CHECK(u.dcd.last == FakeDcd::Stage::stall);
 }
 
@@ -484,7 +474,7 @@ TEST_CASE("GET_REPORT over EP0 returns the last input report of that id, not zer
   REQUIRE(core.send_input(stream));
   dcd.host_poll();
   dcd.sent.clear();
-  core.on_setup(setup(0xA1, 1, 0x0101, 0, 64));  // GET_REPORT, input, id 1
+  core.on_setup(setup_packet(0xA1, 1, 0x0101, 0, 64));  // GET_REPORT, input, id 1
   REQUIRE(dcd.sent.size() == 64);
   CHECK(std::equal(stream.begin(), stream.end(), dcd.sent.begin()));  // before: id + zeros
   // A response report is kept apart from the stream's.
@@ -494,15 +484,15 @@ TEST_CASE("GET_REPORT over EP0 returns the last input report of that id, not zer
   REQUIRE(core.send_input(response));
   dcd.host_poll();
   dcd.sent.clear();
-  core.on_setup(setup(0xA1, 1, 0x0103, 0, 64));
+  core.on_setup(setup_packet(0xA1, 1, 0x0103, 0, 64));
   REQUIRE(dcd.sent.size() == 64);
   CHECK(dcd.sent[5] == 0x5A);
   dcd.sent.clear();
-  core.on_setup(setup(0xA1, 1, 0x0101, 0, 64));
+  core.on_setup(setup_packet(0xA1, 1, 0x0101, 0, 64));
   CHECK(std::equal(stream.begin(), stream.end(), dcd.sent.begin()));
   // Feature reports and unknown ids do not exist: stalled.
-  core.on_setup(setup(0xA1, 1, 0x0301, 0, 64));
+  core.on_setup(setup_packet(0xA1, 1, 0x0301, 0, 64));
   CHECK(dcd.last == FakeDcd::Stage::stall);
-  core.on_setup(setup(0xA1, 1, 0x0107, 0, 64));
+  core.on_setup(setup_packet(0xA1, 1, 0x0107, 0, 64));
   CHECK(dcd.last == FakeDcd::Stage::stall);
 }

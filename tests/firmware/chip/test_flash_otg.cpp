@@ -9,6 +9,7 @@
 #include "board_hal.hpp"
 #include "clock.hpp"
 #include "fake_registers.hpp"
+#include "firmware/usb_setup.hpp"
 #include "otg_fs_dcd.hpp"
 #include "registers.hpp"
 #include "tonus/firmware/nv_record.hpp"
@@ -16,6 +17,7 @@
 
 using namespace tonus;
 using namespace tonus::f405;
+using tonus::test::setup_packet;
 
 namespace {
 
@@ -89,30 +91,31 @@ void model_otg() {
   };
 }
 
-std::array<std::uint8_t, 8> setup(std::uint8_t type, std::uint8_t req, std::uint16_t value, std::uint16_t index) {
-  return {type,
-          req,
-          static_cast<std::uint8_t>(value),
-          static_cast<std::uint8_t>(value >> 8U),
-          static_cast<std::uint8_t>(index),
-          static_cast<std::uint8_t>(index >> 8U),
-          0,
-          0};
-}
+// The OTG controller brought up on the modelled registers, with the device
+// core attached, reset and configured (SET_CONFIGURATION 1) by the host.
+struct ConfiguredOtg {
+  ConfiguredOtg() {
+    fake::reset();
+    model_otg();
+    set_tick_count(0);
+    dcd.attach(&core);
+    init_ok = dcd.init();
+    core.on_bus_reset();
+    core.on_setup(setup_packet(0x00, 9, 1, 0));
+  }
+  OtgFsDcd dcd;
+  usb::DeviceCore core{dcd, 1};
+  bool init_ok = false;
+};
 
 }  // namespace
 
 TEST_CASE("OTG: resume after suspend is handled, and the band streams again without re-enumeration") {
-  fake::reset();
-  model_otg();
-  set_tick_count(0);
-  OtgFsDcd dcd;
-  usb::DeviceCore core(dcd, 1);
-  dcd.attach(&core);
-  REQUIRE(dcd.init());
+  ConfiguredOtg otg_fs;
+  OtgFsDcd& dcd = otg_fs.dcd;
+  usb::DeviceCore& core = otg_fs.core;
+  REQUIRE(otg_fs.init_ok);
   CHECK((fake::registers().get(otg::gintmsk.address) & (1U << 31U)) != 0);  // WKUPINT enabled
-  core.on_bus_reset();
-  core.on_setup(setup(0x00, 9, 1, 0));  // SET_CONFIGURATION 1
   REQUIRE(core.connected());
 
   fake::registers().value[otg::gintsts.address] = 1U << 11U;  // USBSUSP
@@ -132,26 +135,21 @@ TEST_CASE("OTG: resume after suspend is handled, and the band streams again with
 }
 
 TEST_CASE("OTG: ENDPOINT_HALT stalls EP1 IN and drops its FIFO; clearing it resets the data toggle") {
-  fake::reset();
-  model_otg();
-  set_tick_count(0);
-  OtgFsDcd dcd;
-  usb::DeviceCore core(dcd, 1);
-  dcd.attach(&core);
-  REQUIRE(dcd.init());
-  core.on_bus_reset();
-  core.on_setup(setup(0x00, 9, 1, 0));
+  ConfiguredOtg otg_fs;
+  OtgFsDcd& dcd = otg_fs.dcd;
+  usb::DeviceCore& core = otg_fs.core;
+  REQUIRE(otg_fs.init_ok);
   proto::hid::Report r{};
   r[0] = proto::hid::kReportIdStream;
   REQUIRE(core.send_input(r));
   REQUIRE(dcd.hid_busy());
   constexpr std::uint32_t kStall = 1U << 21U, kSd0Pid = 1U << 28U;
-  core.on_setup(setup(0x02, 3, 0, 0x81));  // SET_FEATURE(ENDPOINT_HALT, EP1 IN)
+  core.on_setup(setup_packet(0x02, 3, 0, 0x81));  // SET_FEATURE(ENDPOINT_HALT, EP1 IN)
   CHECK((fake::registers().get(otg::diepctl(1).address) & kStall) != 0);
   CHECK_FALSE(dcd.hid_busy());  // the FIFO was flushed
   CHECK(core.send_input(r));    // queued, but the halted endpoint is not loaded
   CHECK_FALSE(dcd.hid_busy());
-  core.on_setup(setup(0x02, 1, 0, 0x81));  // CLEAR_FEATURE
+  core.on_setup(setup_packet(0x02, 1, 0, 0x81));  // CLEAR_FEATURE
   const std::uint32_t ctl = fake::registers().get(otg::diepctl(1).address);
   CHECK((ctl & kStall) == 0);
   CHECK((ctl & kSd0Pid) != 0);
