@@ -7,12 +7,10 @@
 // 1 a CAN frame (id lo, id hi, data...), 2 a 1 ms sample block.
 #include <cstddef>
 #include <cstdint>
-#include <deque>
 #include <span>
-#include <vector>
 
+#include "fake_board.hpp"
 #include "fuzz_check.hpp"
-#include "sim_hal.hpp"
 #include "tonus/firmware/device.hpp"
 #include "tonus/protocol/hid.hpp"
 
@@ -20,71 +18,35 @@ using namespace tonus;
 
 namespace {
 
-class FuzzHid final : public hal::UsbHid {
- public:
-  [[nodiscard]] bool connected() const override { return true; }
-  bool send_input(const proto::hid::Report& r) override {
+// Every input report the device sent decodes (a stream report or a response).
+void check_sent(test::QueueHid& hid, test::QueueCan& can) {
+  for (const proto::hid::Report& r : hid.sent) {
     proto::StreamMessage m{};
     proto::Response rsp{};
     const bool ok = (r[0] == proto::hid::kReportIdStream && proto::hid::unpack_stream(r, m) == proto::Error::ok) ||
                     (r[0] == proto::hid::kReportIdResponse && proto::hid::unpack_response(r, rsp) == proto::Error::ok);
     TONUS_FUZZ_CHECK(ok);
-    return true;
   }
-  void service() override {}
-  [[nodiscard]] bool idle() const override { return true; }
-  bool receive_output(proto::hid::Report& r, std::size_t& length) override {
-    if (inbox.empty()) return false;
-    r.fill(0);
-    const auto& bytes = inbox.front();
-    length = bytes.size();
-    for (std::size_t k = 0; k < bytes.size() && k < r.size(); ++k) r[k] = bytes[k];
-    inbox.pop_front();
-    return true;
-  }
-  std::deque<std::vector<std::uint8_t>> inbox;
-};
-
-class FuzzCan final : public hal::CanPort {
- public:
-  bool send(const proto::CanFrame& f) override {
-    TONUS_FUZZ_CHECK(f.dlc <= 8);
-    return true;
-  }
-  bool receive(proto::CanFrame& f) override {
-    if (inbox.empty()) return false;
-    f = inbox.front();
-    inbox.pop_front();
-    return true;
-  }
-  [[nodiscard]] bool idle() const override { return true; }
-  std::deque<proto::CanFrame> inbox;
-};
-
-class FuzzSampler final : public hal::EmgSampler {
- public:
-  [[nodiscard]] fw::FrontEnd front_end() const override { return fw::FrontEnd{}; }
-  bool start(std::uint16_t rate_hz) override { return front_end().supports_rate(rate_hz); }
-  const hal::SampleBlock* acquire() override { return pending ? &block : nullptr; }
-  void release() override { pending = false; }
-  hal::SampleBlock block{};
-  bool pending = false;
-};
+  for (const proto::CanFrame& f : can.sent) TONUS_FUZZ_CHECK(f.dlc <= 8);
+  hid.sent.clear();
+  can.sent.clear();
+}
 
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  FuzzSampler sampler;
+  test::ManualSampler sampler(fw::FrontEnd{});
   sim::SimClock clock(false);
   sim::FlashStorage storage;
   sim::SimLed led;
   sim::SimWatchdog watchdog;
   sim::SimSystem system;
-  FuzzHid hid;
-  FuzzCan can;
+  test::QueueHid hid;
+  test::QueueCan can;
   hal::Board board{sampler, clock, storage, led, watchdog, system, &hid, &can, 7, 1};
   fw::Device dev(board);
   dev.boot();
+  check_sent(hid, can);
   std::uint64_t t_us = 0;
   std::uint32_t sequence = 0;
   std::size_t pos = 0;
@@ -105,19 +67,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     } else {
       // A 1 ms block at the sample rate in use, the samples from the input.
       const std::uint16_t rate = dev.config().sample_rate_hz;
-      sampler.block = hal::SampleBlock{};
-      sampler.block.frames = static_cast<std::uint16_t>(rate / 1000U == 0 ? 1 : rate / 1000U);
-      sampler.block.sequence = sequence++;
-      sampler.block.first_sample_us = t_us;
-      for (std::size_t k = 0; k < bytes.size() && k < sampler.block.samples.size(); ++k) {
-        sampler.block.samples[k] = static_cast<std::int16_t>(bytes[k] * 16);
+      hal::SampleBlock block{};
+      block.frames = static_cast<std::uint16_t>(rate / 1000U == 0 ? 1 : rate / 1000U);
+      block.sequence = sequence++;
+      block.first_sample_us = t_us;
+      for (std::size_t k = 0; k < bytes.size() && k < block.samples.size(); ++k) {
+        block.samples[k] = static_cast<std::int16_t>(bytes[k] * 16);
       }
-      sampler.pending = true;
+      sampler.push(block);
     }
     t_us += 1000;
     clock.advance_to(t_us);
     dev.poll();
     if (system.take_reset()) dev.boot();
+    check_sent(hid, can);
     TONUS_FUZZ_CHECK(fw::check_device_config(dev.config(), sampler.front_end()) == proto::ConfigField::none);
   }
   return 0;
