@@ -75,22 +75,20 @@ std::uint64_t micros() {
   return ms * 1000U + static_cast<std::uint64_t>(load - 1U - val) * 1000U / load;
 }
 
-void systick_tick() {
-  // One writer (this interrupt), so plain read-modify-writes suffice.
-  g_tick_seq.store(g_tick_seq.load(std::memory_order_relaxed) + 1U, std::memory_order_relaxed);
-  std::atomic_thread_fence(std::memory_order_release);
-  const std::uint32_t low = g_ms_low.load(std::memory_order_relaxed) + 1U;
-  g_ms_low.store(low, std::memory_order_relaxed);
-  if (low == 0) g_ms_high.store(g_ms_high.load(std::memory_order_relaxed) + 1U, std::memory_order_relaxed);
-  g_tick_seq.store(g_tick_seq.load(std::memory_order_relaxed) + 1U, std::memory_order_release);
-}
-
 void set_tick_count(std::uint64_t ms) {
+  // One writer (the SysTick interrupt, or start-up before it runs): the
+  // sequence counter is odd while the two words change, so readers retry.
   g_tick_seq.store(g_tick_seq.load(std::memory_order_relaxed) + 1U, std::memory_order_relaxed);
   std::atomic_thread_fence(std::memory_order_release);
   g_ms_low.store(static_cast<std::uint32_t>(ms), std::memory_order_relaxed);
   g_ms_high.store(static_cast<std::uint32_t>(ms >> 32U), std::memory_order_relaxed);
   g_tick_seq.store(g_tick_seq.load(std::memory_order_relaxed) + 1U, std::memory_order_release);
+}
+
+void systick_tick() {
+  const std::uint64_t ms = (static_cast<std::uint64_t>(g_ms_high.load(std::memory_order_relaxed)) << 32U) |
+                           g_ms_low.load(std::memory_order_relaxed);
+  set_tick_count(ms + 1U);
 }
 
 }  // namespace tonus::f405
