@@ -67,7 +67,7 @@ bool split_id(std::uint32_t id, Function& f, std::uint8_t& node) {
 bool split_frame(const CanFrame& frame, std::uint32_t id_base, Function& f, std::uint8_t& node) {
   const bool extended = (frame.flags & CanFrame::kExtended) != 0;
   if ((frame.flags & (CanFrame::kRemote | CanFrame::kErrorFrame)) != 0 || extended != (id_base != 0)) return false;
-  if (frame.id < id_base || (frame.id & ~std::uint32_t{0x7FF}) != id_base) return false;
+  if ((frame.id & ~std::uint32_t{0x7FF}) != id_base) return false;  // the base's bits, exactly
   return split_id(frame.id - id_base, f, node);
 }
 
