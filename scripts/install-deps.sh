@@ -12,7 +12,7 @@ packages=(
   doctest-dev libeigen3-dev libbenchmark-dev
   libhidapi-dev libusb-1.0-0-dev libgpiod-dev
   libcli11-dev libtomlplusplus-dev libspdlog-dev libfmt-dev
-  liblo-dev libreaderwriterqueue-dev nlohmann-json3-dev
+  liblo-dev liblo-tools libreaderwriterqueue-dev nlohmann-json3-dev libcpp-httplib-dev
   libmujoco-dev
   # tools used by tests and benchmarks
   can-utils valgrind python3
