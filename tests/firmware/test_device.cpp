@@ -494,6 +494,50 @@ TEST_CASE("a co-contraction ramp through the whole device: levels rise with it; 
   }
 }
 
+TEST_CASE("a co-contraction swell through the whole device: levels rise to the top and fall back") {
+  // tonusd --demo's pattern: 0.5 * peak * (1 - cos(2 pi t / P)), P = 4 s here.
+  SynthSpec sp = spec(Scenario::swell, 4.0F);
+  sp.swell_period_s = 4.0F;
+  Bench b(sp);
+  hal::Board board = b.board();
+  Device dev(board);
+  dev.boot();
+  struct Means {
+    std::array<double, 8> sum{};  // group 0, per half second
+    std::array<int, 8> n{};
+    std::uint32_t t0 = 0;
+    bool started = false;
+  } means;
+  dev.set_report_observer(
+      [](void* ctx, const proto::StreamMessage& m) {
+        auto& mm = *static_cast<Means*>(ctx);
+        if (!mm.started) {
+          mm.t0 = m.device_time_us;
+          mm.started = true;
+        }
+        const auto slot = static_cast<std::size_t>((m.device_time_us - mm.t0) / 500000U);
+        if (slot < mm.sum.size()) {
+          mm.sum[slot] += m.levels[0];
+          ++mm.n[slot];
+        }
+      },
+      &means);
+  while (b.step(dev)) {
+  }
+  std::array<double, 8> mean{};
+  for (std::size_t k = 0; k < mean.size(); ++k) {
+    REQUIRE(means.n[k] > 0);
+    mean[k] = means.sum[k] / means.n[k];
+  }
+  MESSAGE("group 0 level, half-second means: " << mean[0] << " " << mean[1] << " " << mean[2] << " " << mean[3] << " "
+                                               << mean[4] << " " << mean[5] << " " << mean[6] << " " << mean[7]);
+  CHECK(mean[0] < 0.1 * 65535);
+  CHECK(std::max(mean[3], mean[4]) > 0.5 * 65535);
+  CHECK(mean[1] < mean[3]);
+  CHECK(mean[6] < mean[4]);
+  CHECK(mean[7] < 0.25 * 65535);
+}
+
 TEST_CASE("CAN: segmented request and response, stream cycles and heartbeat") {
   Bench b(spec(Scenario::rest, 2.0F));
   hal::Board board = b.board();

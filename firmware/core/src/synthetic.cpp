@@ -33,13 +33,14 @@ const char* to_string(Scenario s) {
     case Scenario::dropout: return "dropout";
     case Scenario::selftest: return "selftest";
     case Scenario::step: return "step";
+    case Scenario::swell: return "swell";
   }
   return "unknown";
 }
 
 bool parse_scenario(const char* name, Scenario& out) {
   for (auto s : {Scenario::rest, Scenario::ramp, Scenario::faults, Scenario::bursts, Scenario::hum, Scenario::dropout,
-                 Scenario::selftest, Scenario::step}) {
+                 Scenario::selftest, Scenario::step, Scenario::swell}) {
     if (equal(name, to_string(s))) {
       out = s;
       return true;
@@ -125,6 +126,11 @@ float SyntheticEmg::activation(std::size_t ch, float t) const {
       // Same expression as the frame times of generate(): the step lands exactly on step_frame.
       const float t_step = static_cast<float>(step_frame(spec_)) / spec_.sample_rate_hz;
       return t >= t_step ? spec_.step_activation : spec_.step_from;
+    }
+    case Scenario::swell: {
+      // 0.5 (1 - cos(2 pi t / P)) = 0.5 (1 - sin(2 pi (t / P + 1/4))): 0 at t = 0, the peak at P / 2.
+      if (!(spec_.swell_period_s > 0.0F)) return 0.0F;
+      return 0.5F * spec_.swell_peak * (1.0F - sin_turns(t / spec_.swell_period_s + 0.25F));
     }
   }
   return 0.0F;

@@ -30,6 +30,8 @@ struct Options {
   std::uint64_t seed = 1;
   unsigned sample_rate_hz = 2000;
   unsigned mains_hz = 50;
+  float step_from = 0.0F, step_to = 0.5F;
+  float swell_period_s = 10.0F, swell_peak = 0.8F;
   bool fast = false;
   std::string json;
   std::string candump;
@@ -122,15 +124,20 @@ int run(const Options& opt) {
   } else {
     fw::SynthSpec spec;
     if (!fw::parse_scenario(opt.synthetic.c_str(), spec.scenario)) {
-      fmt::print(stderr,
-                 "tonus-band-sim: unknown scenario '{}' (rest, ramp, faults, bursts, hum, dropout, selftest, step)\n",
-                 opt.synthetic);
+      fmt::print(
+          stderr,
+          "tonus-band-sim: unknown scenario '{}' (rest, ramp, faults, bursts, hum, dropout, selftest, step, swell)\n",
+          opt.synthetic);
       return 2;
     }
     spec.seed = opt.seed;
     spec.sample_rate_hz = static_cast<float>(opt.sample_rate_hz);
     spec.seconds = static_cast<float>(opt.seconds);
     spec.mains_hz = static_cast<float>(opt.mains_hz);
+    spec.step_from = opt.step_from;
+    spec.step_activation = opt.step_to;
+    spec.swell_period_s = opt.swell_period_s;
+    spec.swell_peak = opt.swell_peak;
     source_name = fmt::format("synthetic {}", opt.synthetic);
     if (spec.scenario == fw::Scenario::step) step_frame = fw::step_frame(spec);
     source = sim::make_synthetic_source(spec);
@@ -255,7 +262,7 @@ int cli_main(int argc, char** argv) {
   CLI::App app{"tonus-band-sim: the band firmware core on Linux (synthetic EMG or a recording)"};
   Options opt;
   auto* synth = app.add_option("--synthetic", opt.synthetic,
-                               "scenario: rest, ramp, faults, bursts, hum, dropout, selftest, step");
+                               "scenario: rest, ramp, faults, bursts, hum, dropout, selftest, step, swell");
   auto* rec =
       app.add_option("--recording", opt.recording, "EMG recording (BioSPPy text or Myo CSV)")->check(CLI::ExistingFile);
   synth->excludes(rec);
@@ -264,6 +271,14 @@ int cli_main(int argc, char** argv) {
   app.add_option("--seed", opt.seed, "seed of the synthetic generator");
   app.add_option("--sample-rate", opt.sample_rate_hz, "synthetic sample rate, Hz")->check(CLI::Range(100, 4000));
   app.add_option("--mains", opt.mains_hz, "synthetic mains frequency, Hz")->check(CLI::IsMember({50, 60}));
+  app.add_option("--step-from", opt.step_from, "step: the effort before the step (0 rest .. 1 MVC)")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--step-to", opt.step_to, "step: the effort after the step (0 rest .. 1 MVC)")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--swell-period", opt.swell_period_s, "swell: seconds of one rise and fall")
+      ->check(CLI::Range(0.1, 1e6));
+  app.add_option("--swell-peak", opt.swell_peak, "swell: the effort at the top (0 rest .. 1 MVC)")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--fast", opt.fast, "run as fast as possible (virtual clock) instead of real time");
   app.add_option("--json", opt.json, "write a JSON summary to FILE");
   app.add_option("--candump", opt.candump, "log every CAN frame in candump -l format to FILE");

@@ -30,6 +30,7 @@ enum class Scenario : std::uint8_t {
   dropout,   // channel 3 stuck at the high rail (broken lead) from 25 % on
   selftest,  // short mixed pattern for the on-target self-test
   step,      // co-contraction step on every channel at half the duration: step_from, then step_activation
+  swell,     // co-contraction rising from rest to swell_peak and falling back, every swell_period_s (1 - cos)
 };
 
 const char* to_string(Scenario s);
@@ -57,6 +58,8 @@ struct SynthSpec {
   float mvc_rms_counts = 300.0F;  // EMG RMS at activation 1 (before the per-channel gain)
   float step_from = 0.0F;         // Scenario::step: the effort before the step (0: rest)
   float step_activation = 0.5F;   // Scenario::step: the effort after the step
+  float swell_period_s = 10.0F;   // Scenario::swell: one rise and fall
+  float swell_peak = 0.8F;        // Scenario::swell: the effort at the top
 };
 
 // Scenario::step: the first frame of the new effort (half the duration, rounded down).

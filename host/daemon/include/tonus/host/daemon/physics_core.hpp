@@ -1,0 +1,128 @@
+// One tick of tonusd's physics thread, with no thread or clock of its own (the
+// caller passes the tick's host time), so tests drive it tick by tick:
+//   read:   band reports -> StiffnessInput (stale -> safe default);
+//           tracker poses -> PoseBuffer (interpolated at the tick, held, eased);
+//           commands (gifts, clear, stiffness override);
+//   update: the avatar controller (dual PD: A stiff -> tau_ff -> B weak x stiffness + gifts);
+//           each gift's reaction measured (peak deflection of its bone, B against A);
+//   write:  the snapshot (triple buffer) and events (queue) for the other threads.
+// Everything is allocated in create(); tick() allocates nothing, never blocks,
+// never logs.
+#pragma once
+
+#include <readerwriterqueue/readerwriterqueue.h>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "tonus/host/avatar/controller.hpp"
+#include "tonus/host/daemon/histogram.hpp"
+#include "tonus/host/daemon/messages.hpp"
+#include "tonus/host/daemon/pose_buffer.hpp"
+#include "tonus/host/daemon/stiffness_input.hpp"
+#include "tonus/host/daemon/triple_buffer.hpp"
+
+namespace tonus::daemon {
+
+struct PhysicsCoreConfig {
+  avatar::AvatarConfig avatar;
+  StiffnessInputConfig stiffness;
+  PoseBufferConfig pose;
+  double reaction_window_s = 2.0;  // a gift's reaction is measured over this long after it appears
+};
+
+// Queue capacities (fixed; a full queue drops the newest item and counts it).
+inline constexpr std::size_t kBandQueue = 1024;  // 1 s of 1 kHz reports
+inline constexpr std::size_t kPoseQueue = 256;   // 2 s of a 120 Hz tracker
+inline constexpr std::size_t kCommandQueue = 64;
+inline constexpr std::size_t kEventQueue = 1024;
+
+// Counters over the core's life (read by the owning thread after ticks).
+struct CoreStats {
+  std::uint64_t ticks = 0;
+  std::uint64_t band_samples = 0;
+  std::uint64_t pose_samples = 0;
+  std::uint64_t commands = 0;
+  std::uint64_t events_dropped = 0;       // the event queue was full
+  std::uint64_t reactions_untracked = 0;  // more gifts at once than reaction slots
+  std::uint64_t avatar_resets = 0;
+};
+
+class PhysicsCore {
+ public:
+  // The model must outlive the core. nullptr and `error` when the config does not fit the model.
+  static std::unique_ptr<PhysicsCore> create(const sim::Model& model, const PhysicsCoreConfig& config,
+                                             std::string& error);
+
+  // Producer sides (one producer each; push_command may be called from any thread).
+  bool push_band(const BandSample& s) { return band_.try_enqueue(s) || count_drop(band_dropped_); }
+  bool push_pose(const PoseSample& s) { return pose_.try_enqueue(s) || count_drop(pose_dropped_); }
+  bool push_command(const Command& c);
+
+  // One tick at host time now_us (the tick's deadline).
+  void tick(std::int64_t now_us);
+
+  // Consumer sides for the other threads.
+  TripleBuffer<Snapshot>& snapshots() { return snapshots_; }
+  moodycamel::ReaderWriterQueue<Event>& events() { return events_; }
+
+  [[nodiscard]] const CoreStats& stats() const { return stats_; }
+  [[nodiscard]] std::uint64_t band_dropped() const { return band_dropped_.load(); }
+  [[nodiscard]] std::uint64_t pose_dropped() const { return pose_dropped_.load(); }
+  [[nodiscard]] std::uint64_t commands_dropped() const { return command_dropped_.load(); }
+  [[nodiscard]] const avatar::AvatarController& controller() const { return *controller_; }
+  [[nodiscard]] const Histogram& band_latency() const { return band_latency_; }  // device sample -> tick, us
+  [[nodiscard]] const PoseBuffer& pose_buffer() const { return pose_buffer_; }
+
+ private:
+  struct Reaction {
+    bool active = false;
+    std::uint32_t id = 0;
+    avatar::GiftId gift;
+    GiftKind kind = GiftKind::cube;
+    sim::Bone bone = sim::Bone::Hips;
+    double start_s = 0.0;
+    double stiffness = 0.0;
+    sim::Vec3 baseline = sim::Vec3::Zero();  // B - A at the bone when the gift appeared
+    double peak_m = 0.0;
+  };
+
+  PhysicsCore(const sim::Model& model, const PhysicsCoreConfig& config, avatar::AvatarController controller);
+  static bool count_drop(std::atomic<std::uint64_t>& n) {
+    n.fetch_add(1, std::memory_order_relaxed);
+    return false;
+  }
+  void emit(const Event& e);
+  void apply(const Command& c);
+  void spawn(const Command& c);
+  void track_reactions();
+  [[nodiscard]] sim::Vec3 bone_offset(sim::Bone b) const;  // B's centre of mass minus A's
+  [[nodiscard]] double group_stiffness(sim::Bone b) const;
+  void publish(std::int64_t now_us);
+
+  const sim::Model* model_;
+  PhysicsCoreConfig config_;
+  std::unique_ptr<avatar::AvatarController> controller_;
+  StiffnessInput stiffness_;
+  PoseBuffer pose_buffer_;
+  moodycamel::ReaderWriterQueue<BandSample> band_{kBandQueue};
+  moodycamel::ReaderWriterQueue<PoseSample> pose_{kPoseQueue};
+  moodycamel::ReaderWriterQueue<Command> commands_{kCommandQueue};
+  std::mutex command_producers_;  // serialises producers only; the physics side never locks
+  moodycamel::ReaderWriterQueue<Event> events_{kEventQueue};
+  TripleBuffer<Snapshot> snapshots_;
+  std::atomic<std::uint64_t> band_dropped_{0}, pose_dropped_{0}, command_dropped_{0};
+  std::optional<Levels> override_;
+  avatar::TickInput input_;
+  std::array<Reaction, sim::kMaxObjects> reactions_{};
+  std::array<std::uint32_t, sim::kMaxObjects> object_ids_{};  // the request id of each object slot
+  std::array<GiftKind, sim::kMaxObjects> object_kinds_{};
+  Histogram band_latency_{10.0, 20000};  // 10 us bins up to 200 ms
+  std::int64_t band_arrival_us_ = 0;
+  bool band_live_ = false;
+  PoseState pose_state_ = PoseState::none;
+  CoreStats stats_;
+};
+
+}  // namespace tonus::daemon

@@ -1,0 +1,217 @@
+#include "tonus/host/daemon/physics_core.hpp"
+
+#include <algorithm>
+
+namespace tonus::daemon {
+
+std::string_view to_string(GiftKind k) { return k == GiftKind::ball ? "ball" : "cube"; }
+
+std::unique_ptr<PhysicsCore> PhysicsCore::create(const sim::Model& model, const PhysicsCoreConfig& config,
+                                                 std::string& error) {
+  if (error = validate(config.stiffness); !error.empty()) return nullptr;
+  if (error = validate(config.pose); !error.empty()) return nullptr;
+  avatar::AvatarController::Created c = avatar::AvatarController::create(model, config.avatar);
+  if (!c) {
+    error = c.error;
+    return nullptr;
+  }
+  return std::unique_ptr<PhysicsCore>(new PhysicsCore(model, config, std::move(*c.controller)));
+}
+
+PhysicsCore::PhysicsCore(const sim::Model& model, const PhysicsCoreConfig& config, avatar::AvatarController controller)
+    : model_(&model),
+      config_(config),
+      controller_(std::make_unique<avatar::AvatarController>(std::move(controller))),
+      stiffness_(config.stiffness),
+      pose_buffer_(model, config.pose) {
+  // Start where the pose buffer starts (neutral, standing), at the safe stiffness.
+  Qpos start{};
+  pose_buffer_.sample(0, start);
+  input_.reference.qpos = start;
+  controller_->resync(input_.reference);
+  controller_->set_stiffness_now(config.stiffness.safe_default);
+}
+
+bool PhysicsCore::push_command(const Command& c) {
+  const std::lock_guard<std::mutex> lock(command_producers_);
+  return commands_.try_enqueue(c) || count_drop(command_dropped_);
+}
+
+void PhysicsCore::emit(const Event& e) {
+  if (!events_.try_enqueue(e)) ++stats_.events_dropped;
+}
+
+sim::Vec3 PhysicsCore::bone_offset(sim::Bone b) const {
+  const std::size_t i = sim::index(b);
+  return controller_->sim_b().xcom[i] - controller_->sim_a().xcom[i];
+}
+
+double PhysicsCore::group_stiffness(sim::Bone b) const {
+  const std::int8_t g = config_.avatar.stiffness.bone_group[sim::index(b)];
+  if (g < 0) return 0.0;
+  return controller_->mapper().applied()[static_cast<std::size_t>(g)];
+}
+
+void PhysicsCore::spawn(const Command& c) {
+  const avatar::SpawnResult r =
+      c.gift == GiftKind::ball ? controller_->throw_ball(c.ball) : controller_->drop_cube(c.cube);
+  const sim::Bone bone = c.gift == GiftKind::ball ? c.ball.target : c.cube.target;
+  Event e;
+  e.time_s = controller_->output().time_s;
+  e.id = c.id;
+  e.gift = c.gift;
+  e.bone = bone;
+  if (!r.ok()) {
+    e.kind = Event::Kind::gift_refused;
+    e.error = r.error;
+    emit(e);
+    return;
+  }
+  const auto slot = static_cast<std::size_t>(r.id.slot);
+  if (slot < object_ids_.size()) {
+    object_ids_[slot] = c.id;
+    object_kinds_[slot] = c.gift;
+  }
+  e.kind = Event::Kind::gift_spawned;
+  e.stiffness = group_stiffness(bone);
+  emit(e);
+  const auto free_slot =
+      std::find_if(reactions_.begin(), reactions_.end(), [](const Reaction& x) { return !x.active; });
+  if (free_slot == reactions_.end()) {
+    ++stats_.reactions_untracked;
+    return;
+  }
+  *free_slot = Reaction{true, c.id, r.id, c.gift, bone, e.time_s, e.stiffness, bone_offset(bone), 0.0};
+}
+
+void PhysicsCore::apply(const Command& c) {
+  ++stats_.commands;
+  Event e;
+  e.time_s = controller_->output().time_s;
+  e.id = c.id;
+  switch (c.kind) {
+    case Command::Kind::gift: spawn(c); return;
+    case Command::Kind::clear_gifts:
+      controller_->clear_gifts();
+      e.kind = Event::Kind::gifts_cleared;
+      break;
+    case Command::Kind::stiffness_override:
+      override_ = c.levels;
+      for (double& v : *override_) v = std::isfinite(v) ? std::clamp(v, 0.0, 1.0) : 0.5;
+      e.kind = Event::Kind::stiffness_override;
+      e.levels = *override_;
+      break;
+    case Command::Kind::stiffness_release:
+      override_.reset();
+      e.kind = Event::Kind::stiffness_release;
+      break;
+  }
+  emit(e);
+}
+
+void PhysicsCore::track_reactions() {
+  const double now_s = controller_->output().time_s;
+  for (Reaction& r : reactions_) {
+    if (!r.active) continue;
+    const auto slot = static_cast<std::size_t>(r.gift.slot);
+    const sim::Object& obj = controller_->sim_b().objects[slot];
+    const bool alive = obj.active && obj.generation == r.gift.generation;
+    if (alive) r.peak_m = std::max(r.peak_m, (bone_offset(r.bone) - r.baseline).norm());
+    if (!alive || now_s - r.start_s >= config_.reaction_window_s) {
+      Event e;
+      e.kind = Event::Kind::gift_reaction;
+      e.time_s = now_s;
+      e.id = r.id;
+      e.gift = r.kind;
+      e.bone = r.bone;
+      e.stiffness = r.stiffness;
+      e.peak_deflection_m = r.peak_m;
+      emit(e);
+      r.active = false;
+    }
+  }
+}
+
+void PhysicsCore::publish(std::int64_t now_us) {
+  const avatar::TickOutput& out = controller_->output();
+  Snapshot& s = snapshots_.write_slot();
+  s.tick = stats_.ticks;
+  s.time_s = out.time_s;
+  s.tick_host_us = now_us;
+  s.qpos = out.qpos;
+  s.stiffness = out.stiffness;
+  s.band_live = band_live_;
+  s.override_active = override_.has_value();
+  s.pose_state = pose_state_;
+  s.band_arrival_us = band_arrival_us_;
+  s.nobjects = 0;
+  const sim::Data& b = controller_->sim_b();
+  for (std::size_t k = 0; k < b.objects.size(); ++k) {
+    const sim::Object& o = b.objects[k];
+    if (!o.active) continue;
+    ObjectView& v = s.objects[static_cast<std::size_t>(s.nobjects++)];
+    v.id = object_ids_[k];
+    v.kind = object_kinds_[k];
+    v.size_m = o.shape.type == sim::ShapeType::box ? 2.0 * o.shape.half_extents_m.x() : o.shape.radius_m;
+    v.pos = o.pos;
+    v.rot = o.quat;
+  }
+  snapshots_.publish();
+}
+
+void PhysicsCore::tick(std::int64_t now_us) {
+  // read
+  BandSample band;
+  while (band_.try_dequeue(band)) {
+    ++stats_.band_samples;
+    stiffness_.on_report(band.arrival_us, band.levels);
+    band_arrival_us_ = std::max(band_arrival_us_, band.arrival_us);
+    if (band.sampled_host_us > 0) band_latency_.add(static_cast<double>(now_us - band.sampled_host_us));
+  }
+  PoseSample* pose = nullptr;
+  while ((pose = pose_.peek()) != nullptr) {
+    ++stats_.pose_samples;
+    pose_buffer_.push(*pose);
+    pose_.pop();
+  }
+  Command cmd;
+  while (commands_.try_dequeue(cmd)) apply(cmd);
+
+  const PoseState ps = pose_buffer_.sample(now_us, input_.reference.qpos);
+  input_.reference.has_velocity = false;
+  if (ps != pose_state_) {
+    Event e;
+    e.kind = Event::Kind::tracker_state;
+    e.time_s = controller_->output().time_s;
+    e.pose_state = ps;
+    emit(e);
+    pose_state_ = ps;
+  }
+  const bool live = stiffness_.live(now_us);
+  if (live != band_live_ && stiffness_.ever_received()) {
+    Event e;
+    e.kind = live ? Event::Kind::band_live : Event::Kind::band_stale;
+    e.time_s = controller_->output().time_s;
+    emit(e);
+  }
+  band_live_ = live;
+  input_.stiffness = override_ ? *override_ : stiffness_.at(now_us);
+
+  // update
+  const avatar::TickOutput& out = controller_->tick(input_);
+  ++stats_.ticks;
+  if ((out.flags & (avatar::kResetA | avatar::kResetB)) != 0) {
+    ++stats_.avatar_resets;
+    Event e;
+    e.kind = Event::Kind::avatar_reset;
+    e.time_s = out.time_s;
+    e.flags = out.flags;
+    emit(e);
+  }
+  track_reactions();
+
+  // write
+  publish(now_us);
+}
+
+}  // namespace tonus::daemon
