@@ -140,8 +140,8 @@ host::ReconnectingBandLink::Opener BandInput::make_opener() {
     } else {
       args = {"--synthetic", b.sim_synthetic, "--seed", std::to_string(b.sim_seed)};
     }
-    // 0: as long as tonusd runs (a week is long enough for any session).
-    args.insert(args.end(), {"--seconds", fmt::format("{}", b.sim_seconds > 0.0 ? b.sim_seconds : 604800.0)});
+    // 0: as long as tonusd runs (a day: the simulator's longest run; the link reopens a new one after).
+    args.insert(args.end(), {"--seconds", fmt::format("{}", b.sim_seconds > 0.0 ? b.sim_seconds : 86400.0)});
     args.insert(args.end(), {b.sim_link == SimLink::hid ? "--hid-fd" : "--can-fd", "3", "--quiet"});
     args.insert(args.end(), b.sim_args.begin(), b.sim_args.end());
     const int fd = child_->spawn(path, args, error);

@@ -151,12 +151,15 @@ void PhysicsCore::publish(std::int64_t now_us) {
     if (!o.active) continue;
     ObjectView& v = s.objects[static_cast<std::size_t>(s.nobjects++)];
     v.id = object_ids_[k];
+    v.slot = static_cast<int>(k);
     v.kind = object_kinds_[k];
     v.size_m = o.shape.type == sim::ShapeType::box ? 2.0 * o.shape.half_extents_m.x() : o.shape.radius_m;
     v.pos = o.pos;
     v.rot = o.quat;
   }
+  status_snapshots_.write_slot() = s;
   snapshots_.publish();
+  status_snapshots_.publish();
 }
 
 void PhysicsCore::tick(std::int64_t now_us) {
@@ -200,6 +203,10 @@ void PhysicsCore::tick(std::int64_t now_us) {
   // update
   const avatar::TickOutput& out = controller_->tick(input_);
   ++stats_.ticks;
+  for (std::size_t g = 0; g < out.stiffness.size(); ++g) {
+    stats_.stiffness_min[g] = std::min(stats_.stiffness_min[g], out.stiffness[g]);
+    stats_.stiffness_max[g] = std::max(stats_.stiffness_max[g], out.stiffness[g]);
+  }
   if ((out.flags & (avatar::kResetA | avatar::kResetB)) != 0) {
     ++stats_.avatar_resets;
     Event e;

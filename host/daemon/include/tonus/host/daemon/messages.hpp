@@ -68,7 +68,8 @@ struct Event {
 
 // One virtual object as the output sees it.
 struct ObjectView {
-  std::uint32_t id = 0;
+  std::uint32_t id = 0;  // the request's id
+  int slot = 0;          // the physics slot: stable while the object lives
   GiftKind kind = GiftKind::cube;
   double size_m = 0.0;  // ball: radius; cube: edge
   sim::Vec3 pos = sim::Vec3::Zero();

@@ -47,6 +47,8 @@ struct CoreStats {
   std::uint64_t events_dropped = 0;       // the event queue was full
   std::uint64_t reactions_untracked = 0;  // more gifts at once than reaction slots
   std::uint64_t avatar_resets = 0;
+  Levels stiffness_min{1.0, 1.0, 1.0, 1.0};  // applied, over every tick
+  Levels stiffness_max{0.0, 0.0, 0.0, 0.0};
 };
 
 class PhysicsCore {
@@ -63,8 +65,10 @@ class PhysicsCore {
   // One tick at host time now_us (the tick's deadline).
   void tick(std::int64_t now_us);
 
-  // Consumer sides for the other threads.
+  // Consumer sides for the other threads: one snapshot buffer for the
+  // output thread, one for the status (main) thread.
   TripleBuffer<Snapshot>& snapshots() { return snapshots_; }
+  TripleBuffer<Snapshot>& status_snapshots() { return status_snapshots_; }
   moodycamel::ReaderWriterQueue<Event>& events() { return events_; }
 
   [[nodiscard]] const CoreStats& stats() const { return stats_; }
@@ -112,6 +116,7 @@ class PhysicsCore {
   std::mutex command_producers_;  // serialises producers only; the physics side never locks
   moodycamel::ReaderWriterQueue<Event> events_{kEventQueue};
   TripleBuffer<Snapshot> snapshots_;
+  TripleBuffer<Snapshot> status_snapshots_;
   std::atomic<std::uint64_t> band_dropped_{0}, pose_dropped_{0}, command_dropped_{0};
   std::optional<Levels> override_;
   avatar::TickInput input_;

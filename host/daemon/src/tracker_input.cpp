@@ -1,0 +1,190 @@
+#include "tonus/host/daemon/tracker_input.hpp"
+
+#include <filesystem>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "tonus/host/reference/body_retarget.hpp"
+#include "tonus/host/reference/calibration.hpp"
+#include "tonus/host/reference/tracker_ik.hpp"
+#include "tonus/host/transport/host_clock.hpp"
+#include "tonus/host/vmc/receiver.hpp"
+#include "tonus/sim/humanoid.hpp"
+
+namespace tonus::daemon {
+
+std::string default_bvh_path() { return std::string(TONUS_DATA_DIR) + "/cmu_02_walk.bvh"; }
+
+// The VMC source: the receiver, and what turns its frames into poses.
+struct TrackerInput::Vmc {
+  std::unique_ptr<vmc::VmcReceiver> receiver;
+  // performer mode
+  std::optional<reference::BodyRetarget> retarget;
+  reference::BodyRetargetState retarget_state;
+  // tracker mode: calibrated from the first frame with the head and both
+  // hands (the performer stands in a T-pose when tracking starts), positions
+  // scaled so the performer's height is the humanoid's.
+  std::optional<reference::IkModel> ik;
+  reference::IkState ik_state;
+  reference::IkOutput ik_out;
+  double scale = 1.0;
+  std::string note;  // what happened, for the log (set on the tracker thread, logged there)
+};
+
+TrackerInput::TrackerInput(const TrackerConfig& config, const sim::Model& model, PhysicsCore& core)
+    : config_(config), model_(model), core_(core) {}
+
+TrackerInput::~TrackerInput() { stop(); }
+
+bool TrackerInput::start(std::string& error) {
+  if (thread_.joinable() || config_.source == TrackerSource::none) return true;
+  stop_.store(false);
+  if (config_.source == TrackerSource::bvh) {
+    const std::string path = config_.bvh_path.empty() ? default_bvh_path() : config_.bvh_path;
+    clip_ = reference::clip_to_reference(model_, path);
+    if (!clip_.ok()) {
+      error = fmt::format("tracker.bvh_path = \"{}\": {}", path, clip_.error);
+      return false;
+    }
+    if (clip_.qpos.size() <= clip_.first_frame || !(clip_.dt_s > 0.0)) {
+      error = fmt::format("tracker.bvh_path = \"{}\": no frames to play", path);
+      return false;
+    }
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      status_.source = fmt::format("bvh {} ({} frames at {:.0f} Hz{})", path, clip_.qpos.size() - clip_.first_frame,
+                                   1.0 / clip_.dt_s, config_.bvh_loop ? ", looping" : "");
+    }
+    spdlog::info("tracker: {}", status_.source);
+    thread_ = std::thread([this] { run_bvh(); });
+    return true;
+  }
+  vmc::ReceiverOptions o;
+  o.address = config_.listen_address;
+  o.port = config_.listen_port;
+  o.mode = config_.vmc_mode == VmcMode::performer ? vmc::ReceiverMode::performer : vmc::ReceiverMode::tracker;
+  vmc_ = std::make_unique<Vmc>();
+  vmc_->receiver = std::make_unique<vmc::VmcReceiver>(o);
+  if (!vmc_->receiver->ok()) {
+    error = fmt::format("tracker.listen_address = \"{}\", tracker.listen_port = {}: {}", config_.listen_address,
+                        config_.listen_port, vmc_->receiver->error());
+    vmc_.reset();
+    return false;
+  }
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    status_.source = fmt::format("vmc {} mode on {}:{}", to_string(config_.vmc_mode), config_.listen_address,
+                                 vmc_->receiver->port());
+  }
+  spdlog::info("tracker: {}", status_.source);
+  thread_ = std::thread([this] { run_vmc(); });
+  return true;
+}
+
+int TrackerInput::vmc_port() const { return vmc_ && vmc_->receiver ? vmc_->receiver->port() : 0; }
+
+void TrackerInput::stop() {
+  stop_.store(true);
+  if (thread_.joinable()) thread_.join();
+}
+
+TrackerStatus TrackerInput::status() const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return status_;
+}
+
+void TrackerInput::count_frame(bool pushed) {
+  const std::int64_t now = host::steady_now_us();
+  const std::lock_guard<std::mutex> lock(mutex_);
+  ++(pushed ? status_.frames : status_.dropped);
+  ++rate_window_frames_;
+  if (rate_window_start_us_ == 0) rate_window_start_us_ = now;
+  if (now - rate_window_start_us_ >= 1'000'000) {
+    status_.rate_hz = static_cast<double>(rate_window_frames_) * 1e6 / static_cast<double>(now - rate_window_start_us_);
+    rate_window_start_us_ = now;
+    rate_window_frames_ = 0;
+  }
+}
+
+void TrackerInput::run_bvh() {
+  const auto dt_us = static_cast<std::int64_t>(std::llround(clip_.dt_s * 1e6));
+  std::int64_t t_us = host::steady_now_us();
+  std::size_t k = clip_.first_frame;
+  PoseSample s;
+  while (!stop_.load()) {
+    if (k >= clip_.qpos.size()) {
+      if (!config_.bvh_loop) return;  // the stream ends: the physics core holds, then eases to neutral
+      k = clip_.first_frame;
+      const std::lock_guard<std::mutex> lock(mutex_);
+      ++status_.loops;
+    }
+    // Sleep in short steps so stop() is prompt even for a slow clip.
+    while (!stop_.load() && host::steady_now_us() < t_us) {
+      std::this_thread::sleep_for(
+          std::chrono::microseconds(std::min<std::int64_t>(t_us - host::steady_now_us(), 5000)));
+    }
+    s.t_us = t_us;
+    s.qpos = clip_.qpos[k];
+    count_frame(core_.push_pose(s));
+    ++k;
+    t_us += dt_us;
+  }
+}
+
+void TrackerInput::run_vmc() {
+  Vmc& v = *vmc_;
+  PoseSample s;
+  v.receiver->set_handler([this, &v, &s](const vmc::ReceivedFrame& f) {
+    if (f.mode == vmc::ReceiverMode::performer) {
+      if (!v.retarget && f.skeleton_ready && v.receiver->skeleton()) {
+        reference::BodyRetargetBuild b = reference::BodyRetarget::create(model_, *v.receiver->skeleton());
+        if (!b.ok()) {
+          spdlog::warn("tracker: the VMC sender's skeleton cannot be retargeted: {}", b.error);
+          v.receiver->reset_skeleton();
+          return;
+        }
+        v.retarget = std::move(*b.retarget);
+        spdlog::info("tracker: VMC performer skeleton learnt (scale {:.3f})", v.retarget->scale());
+      }
+      if (!v.retarget) return;
+      s.qpos = model_.qpos0;
+      v.retarget->solve(f.body, v.retarget_state, s.qpos);
+    } else {
+      reference::TrackerFrame frame = f.trackers;
+      frame.time_s = static_cast<double>(f.arrival_us) * 1e-6;
+      if (!v.ik) {
+        const reference::CalibrationResult raw = reference::calibrate(frame);
+        if (!raw.ok()) return;                                       // waiting for the head and both hands
+        v.scale = sim::HumanoidSpec{}.height_m / raw.body.height_m;  // tonusd drives the default humanoid
+        for (auto& p : frame.pose) p.pos_m *= v.scale;
+        const reference::CalibrationResult cal = reference::calibrate(frame);
+        if (!cal.ok()) return;
+        reference::IkCreated ik = reference::make_ik_model(model_, cal.body);
+        if (!ik.model) {
+          spdlog::warn("tracker: IK cannot be set up: {}", ik.error);
+          return;
+        }
+        v.ik = std::move(*ik.model);
+        spdlog::info("tracker: calibrated from the first full frame: performer {:.2f} m, scaled by {:.3f}",
+                     raw.body.height_m, v.scale);
+      } else {
+        for (auto& p : frame.pose) p.pos_m *= v.scale;
+      }
+      reference::solve_ik(*v.ik, v.ik_state, frame, v.ik_out);
+      s.qpos = v.ik_out.qpos;
+    }
+    s.t_us = f.arrival_us;
+    count_frame(core_.push_pose(s));
+  });
+  while (!stop_.load()) {
+    v.receiver->receive(20);
+    const vmc::ReceiverCounters& c = v.receiver->counters();
+    const std::lock_guard<std::mutex> lock(mutex_);
+    status_.vmc_messages = c.messages;
+    status_.vmc_ignored = c.ignored;
+    status_.vmc_malformed = c.malformed;
+  }
+}
+
+}  // namespace tonus::daemon

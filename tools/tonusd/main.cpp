@@ -1,0 +1,168 @@
+// tonusd: the host daemon. Band and trackers in, the avatar at a fixed rate,
+// VMC out to the avatar engine. `tonusd --demo` runs with no hardware and no
+// config file (docs/daemon.md).
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include <fmt/format.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
+
+#include "tonus/host/daemon/config_file.hpp"
+#include "tonus/host/daemon/daemon.hpp"
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+
+extern "C" void on_signal(int /*sig*/) { g_stop.store(true); }
+
+std::string exe_dir() {
+  std::error_code ec;
+  const std::filesystem::path p = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string(".") : p.parent_path().string();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace tonus::daemon;
+  CLI::App app{"tonusd: EMG-set stiffness for a physics avatar that follows motion capture, sent out as VMC"};
+  std::string config_path, json_path;
+  bool demo = false, print_config = false, no_realtime = false, no_control = false;
+  double seconds = -1.0;
+  // Flags that override the file (each names its key in docs/daemon.md).
+  std::string band_source, band_socket, sim_synthetic, tracker_source, bvh_path, vmc_mode, vmc_host, listen_address,
+      log_level, candump_path;
+  std::vector<std::string> sim_args;
+  int vmc_port = -1, listen_port = -1, control_port = -1;
+  double vmc_rate = -1.0, rate_hz = -1.0;
+  app.add_option("--config", config_path, "TOML configuration file (defaults for every key left out)");
+  app.add_flag("--demo", demo, "the demo: simulated band, bundled clip, gifts on a schedule (no hardware, no file)");
+  app.add_option("--seconds", seconds, "run this long, then exit (default: --demo's demo.seconds, else until Ctrl-C)");
+  app.add_option("--json", json_path, "write the run's summary as JSON to FILE at exit");
+  app.add_flag("--print-config", print_config, "print the effective configuration as TOML and exit");
+  app.add_option("--band", band_source, "band.source: sim, socket, hid, can, candump, none");
+  app.add_option("--band-socket", band_socket, "band.sim_socket: a tonus-band-sim serving --hid-socket PATH");
+  app.add_option("--band-candump", candump_path, "band.candump_path: a candump log to replay");
+  app.add_option("--sim-synthetic", sim_synthetic, "band.sim_synthetic: the simulator's scenario");
+  app.add_option("--sim-arg", sim_args, "band.sim_args: an argument for the simulator (repeat)")
+      ->allow_extra_args(false);
+  app.add_option("--tracker", tracker_source, "tracker.source: bvh, vmc, none");
+  app.add_option("--bvh", bvh_path, "tracker.bvh_path: the clip to play");
+  app.add_option("--vmc-mode", vmc_mode, "tracker.vmc_mode: performer, trackers");
+  app.add_option("--listen-address", listen_address, "tracker.listen_address");
+  app.add_option("--listen-port", listen_port, "tracker.listen_port (VMC in; 0: any free port)");
+  app.add_option("--vmc-host", vmc_host, "output.host (VMC out)");
+  app.add_option("--vmc-port", vmc_port, "output.port (VMC out)");
+  app.add_option("--vmc-rate", vmc_rate, "output.rate_hz (1..200)");
+  app.add_option("--rate-hz", rate_hz, "physics.rate_hz");
+  app.add_option("--control-port", control_port, "control.port (0: any free port)");
+  app.add_flag("--no-control", no_control, "control.enabled = false");
+  app.add_flag("--no-realtime", no_realtime, "physics.realtime_priority = 0 and physics.lock_memory = false");
+  app.add_option("--log-level", log_level, "log.level: trace, debug, info, warn, error, off");
+  CLI11_PARSE(app, argc, argv);
+
+  DaemonConfig cfg;
+  if (!config_path.empty()) {
+    if (const std::string e = load_config(config_path, cfg); !e.empty()) {
+      std::cerr << "tonusd: " << e << "\n";
+      return 2;
+    }
+  }
+  if (!band_source.empty()) {
+    const std::string text = fmt::format("[band]\nsource = \"{}\"\n", band_source);
+    if (const std::string e = parse_config(text, "--band", cfg); !e.empty()) {
+      std::cerr << "tonusd: " << e << "\n";
+      return 2;
+    }
+  }
+  if (!tracker_source.empty()) {
+    if (const std::string e =
+            parse_config(fmt::format("[tracker]\nsource = \"{}\"\n", tracker_source), "--tracker", cfg);
+        !e.empty()) {
+      std::cerr << "tonusd: " << e << "\n";
+      return 2;
+    }
+  }
+  if (!vmc_mode.empty()) {
+    if (const std::string e = parse_config(fmt::format("[tracker]\nvmc_mode = \"{}\"\n", vmc_mode), "--vmc-mode", cfg);
+        !e.empty()) {
+      std::cerr << "tonusd: " << e << "\n";
+      return 2;
+    }
+  }
+  if (!band_socket.empty()) cfg.band.sim_socket = band_socket;
+  if (!candump_path.empty()) cfg.band.candump_path = candump_path;
+  if (!sim_synthetic.empty()) cfg.band.sim_synthetic = sim_synthetic;
+  if (!sim_args.empty()) cfg.band.sim_args = sim_args;
+  if (!bvh_path.empty()) cfg.tracker.bvh_path = bvh_path;
+  if (!listen_address.empty()) cfg.tracker.listen_address = listen_address;
+  if (listen_port >= 0) cfg.tracker.listen_port = listen_port;
+  if (!vmc_host.empty()) cfg.output.host = vmc_host;
+  if (vmc_port >= 0) cfg.output.port = vmc_port;
+  if (vmc_rate >= 0.0) cfg.output.rate_hz = vmc_rate;
+  if (rate_hz >= 0.0) cfg.physics.rate_hz = rate_hz;
+  if (control_port >= 0) cfg.control.port = control_port;
+  if (no_control) cfg.control.enabled = false;
+  if (no_realtime) {
+    cfg.physics.realtime_priority = 0;
+    cfg.physics.lock_memory = false;
+  }
+  if (!log_level.empty()) cfg.log.level = log_level;
+  if (demo && seconds >= 0.0) cfg.demo.seconds = seconds;
+  if (demo && cfg.band.source == BandSource::sim && cfg.band.sim_args.empty() && cfg.band.sim_recording.empty() &&
+      cfg.band.sim_synthetic == "swell") {
+    // One rise and fall of co-contraction over the demo.
+    cfg.band.sim_args = {"--swell-period", fmt::format("{}", cfg.demo.seconds)};
+  }
+  if (const std::string e = validate(cfg); !e.empty()) {
+    std::cerr << "tonusd: " << e << "\n";
+    return 2;
+  }
+  if (print_config) {
+    std::cout << to_toml(cfg);
+    return 0;
+  }
+
+  auto logger = spdlog::stderr_color_mt("tonusd");
+  spdlog::set_default_logger(logger);
+  spdlog::set_level(spdlog::level::from_str(cfg.log.level));
+  spdlog::set_pattern("%H:%M:%S.%e %^%l%$ %v");
+
+  std::signal(SIGPIPE, SIG_IGN);
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+
+  std::string error;
+  std::unique_ptr<Daemon> d = Daemon::create(cfg, exe_dir(), error);
+  if (!d) {
+    std::cerr << "tonusd: " << error << "\n";
+    return 2;
+  }
+  if (!d->start(error)) {
+    std::cerr << "tonusd: " << error << "\n";
+    return 1;
+  }
+  const double run_s = seconds >= 0.0 ? seconds : (demo ? cfg.demo.seconds : 0.0);
+  d->run_for(run_s, g_stop, demo);
+  d->stop();
+  std::cout << d->summary_text();
+  if (!json_path.empty()) {
+    std::ofstream out(json_path);
+    out << d->summary_json().dump(2) << "\n";
+    if (!out) {
+      std::cerr << "tonusd: cannot write " << json_path << "\n";
+      return 1;
+    }
+  }
+  return 0;
+}
