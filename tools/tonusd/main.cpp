@@ -76,6 +76,25 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  if (!band_socket.empty()) cfg.band.sim_socket = band_socket;
+  if (!candump_path.empty()) cfg.band.candump_path = candump_path;
+  if (!sim_synthetic.empty()) cfg.band.sim_synthetic = sim_synthetic;
+  if (!sim_args.empty()) cfg.band.sim_args = sim_args;
+  if (!bvh_path.empty()) cfg.tracker.bvh_path = bvh_path;
+  if (!listen_address.empty()) cfg.tracker.listen_address = listen_address;
+  if (listen_port >= 0) cfg.tracker.listen_port = listen_port;
+  if (!vmc_host.empty()) cfg.output.host = vmc_host;
+  if (vmc_port >= 0) cfg.output.port = vmc_port;
+  if (vmc_rate >= 0.0) cfg.output.rate_hz = vmc_rate;
+  if (rate_hz >= 0.0) cfg.physics.rate_hz = rate_hz;
+  if (control_port >= 0) cfg.control.port = control_port;
+  if (no_control) cfg.control.enabled = false;
+  if (no_realtime) {
+    cfg.physics.realtime_priority = 0;
+    cfg.physics.lock_memory = false;
+  }
+  if (!log_level.empty()) cfg.log.level = log_level;
+  // The enum flags last: parse_config validates the whole config, so the paths they need are set by now.
   if (!band_source.empty()) {
     const std::string text = fmt::format("[band]\nsource = \"{}\"\n", band_source);
     if (const std::string e = parse_config(text, "--band", cfg); !e.empty()) {
@@ -98,24 +117,6 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (!band_socket.empty()) cfg.band.sim_socket = band_socket;
-  if (!candump_path.empty()) cfg.band.candump_path = candump_path;
-  if (!sim_synthetic.empty()) cfg.band.sim_synthetic = sim_synthetic;
-  if (!sim_args.empty()) cfg.band.sim_args = sim_args;
-  if (!bvh_path.empty()) cfg.tracker.bvh_path = bvh_path;
-  if (!listen_address.empty()) cfg.tracker.listen_address = listen_address;
-  if (listen_port >= 0) cfg.tracker.listen_port = listen_port;
-  if (!vmc_host.empty()) cfg.output.host = vmc_host;
-  if (vmc_port >= 0) cfg.output.port = vmc_port;
-  if (vmc_rate >= 0.0) cfg.output.rate_hz = vmc_rate;
-  if (rate_hz >= 0.0) cfg.physics.rate_hz = rate_hz;
-  if (control_port >= 0) cfg.control.port = control_port;
-  if (no_control) cfg.control.enabled = false;
-  if (no_realtime) {
-    cfg.physics.realtime_priority = 0;
-    cfg.physics.lock_memory = false;
-  }
-  if (!log_level.empty()) cfg.log.level = log_level;
   if (demo && seconds >= 0.0) cfg.demo.seconds = seconds;
   if (demo && cfg.band.source == BandSource::sim && cfg.band.sim_args.empty() && cfg.band.sim_recording.empty() &&
       cfg.band.sim_synthetic == "swell") {

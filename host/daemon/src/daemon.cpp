@@ -167,13 +167,14 @@ void Daemon::drain_events() {
       case Event::Kind::gift_spawned: {
         spdlog::info("gift {}: a {} at the {} (stiffness {:.2f})", e.id, to_string(e.gift), bone, e.stiffness);
         const std::lock_guard<std::mutex> lock(mutex_);
-        gifts_.push_back({e.id, std::string(to_string(e.gift)), bone, e.time_s, e.stiffness, 0.0, false, ""});
+        gifts_.push_back(
+            {e.id, std::string(to_string(e.gift)), bone, e.time_s, e.stiffness, e.natural_hz, 0.0, false, ""});
         break;
       }
       case Event::Kind::gift_refused: {
         spdlog::warn("gift {}: a {} at the {} refused: {}", e.id, to_string(e.gift), bone, avatar::to_string(e.error));
         const std::lock_guard<std::mutex> lock(mutex_);
-        gifts_.push_back({e.id, std::string(to_string(e.gift)), bone, e.time_s, 0.0, 0.0, false,
+        gifts_.push_back({e.id, std::string(to_string(e.gift)), bone, e.time_s, 0.0, 0.0, 0.0, false,
                           std::string(avatar::to_string(e.error))});
         break;
       }
@@ -348,6 +349,9 @@ nlohmann::json Daemon::summary_json() const {
   j["output_period_us"] = 1e6 / config_.output.rate_hz;
   j["tracker_frames"] = t.frames;
   j["tracker_source"] = t.source;
+  j["tracker_vmc_messages"] = t.vmc_messages;
+  j["tracker_vmc_malformed"] = t.vmc_malformed;
+  j["tracker_vmc_ignored"] = t.vmc_ignored;
   j["avatar_resets"] = cs.avatar_resets;
   j["stiffness_min"] = levels_json(cs.stiffness_min);
   j["stiffness_max"] = levels_json(cs.stiffness_max);
@@ -359,6 +363,7 @@ nlohmann::json Daemon::summary_json() const {
                      {"bone", g.bone},
                      {"at_s", g.at_s},
                      {"stiffness", g.stiffness},
+                     {"natural_hz", g.natural_hz},
                      {"peak_deflection_m", g.peak_deflection_m},
                      {"measured", g.measured}};
     if (!g.refused.empty()) x["refused"] = g.refused;

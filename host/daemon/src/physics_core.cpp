@@ -52,6 +52,13 @@ double PhysicsCore::group_stiffness(sim::Bone b) const {
   return controller_->mapper().applied()[static_cast<std::size_t>(g)];
 }
 
+double PhysicsCore::group_hz(sim::Bone b) const {
+  const std::int8_t g = config_.avatar.stiffness.bone_group[sim::index(b)];
+  if (g < 0) return config_.avatar.stiffness.ungrouped.min_hz;
+  const auto gi = static_cast<std::size_t>(g);
+  return controller_->mapper().frequency_hz(gi, controller_->mapper().applied()[gi]);
+}
+
 void PhysicsCore::spawn(const Command& c) {
   const avatar::SpawnResult r =
       c.gift == GiftKind::ball ? controller_->throw_ball(c.ball) : controller_->drop_cube(c.cube);
@@ -74,6 +81,7 @@ void PhysicsCore::spawn(const Command& c) {
   }
   e.kind = Event::Kind::gift_spawned;
   e.stiffness = group_stiffness(bone);
+  e.natural_hz = group_hz(bone);
   emit(e);
   const auto free_slot =
       std::find_if(reactions_.begin(), reactions_.end(), [](const Reaction& x) { return !x.active; });
@@ -81,7 +89,7 @@ void PhysicsCore::spawn(const Command& c) {
     ++stats_.reactions_untracked;
     return;
   }
-  *free_slot = Reaction{true, c.id, r.id, c.gift, bone, e.time_s, e.stiffness, bone_offset(bone), 0.0};
+  *free_slot = Reaction{true, c.id, r.id, c.gift, bone, e.time_s, e.stiffness, e.natural_hz, bone_offset(bone), 0.0};
 }
 
 void PhysicsCore::apply(const Command& c) {
@@ -125,6 +133,7 @@ void PhysicsCore::track_reactions() {
       e.gift = r.kind;
       e.bone = r.bone;
       e.stiffness = r.stiffness;
+      e.natural_hz = r.natural_hz;
       e.peak_deflection_m = r.peak_m;
       emit(e);
       r.active = false;

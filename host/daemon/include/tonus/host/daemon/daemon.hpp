@@ -27,8 +27,9 @@ struct GiftRecord {
   std::uint32_t id = 0;
   std::string kind;
   std::string bone;
-  double at_s = 0.0;       // physics time it appeared
-  double stiffness = 0.0;  // its bone group's applied stiffness then
+  double at_s = 0.0;        // physics time it appeared
+  double stiffness = 0.0;   // its bone group's applied stiffness then
+  double natural_hz = 0.0;  // ... and that group's drive frequency (the weak gains)
   double peak_deflection_m = 0.0;
   bool measured = false;  // the reaction window closed
   std::string refused;    // why it was refused (empty: it appeared)

@@ -59,6 +59,7 @@ struct Event {
   GiftKind gift = GiftKind::cube;
   sim::Bone bone = sim::Bone::Hips;
   double stiffness = 0.0;
+  double natural_hz = 0.0;  // the bone's group drive frequency at that stiffness (the weak gains: Kp = w^2 I)
   double peak_deflection_m = 0.0;
   avatar::GiftError error = avatar::GiftError::none;
   std::uint32_t flags = 0;

@@ -88,6 +88,7 @@ class PhysicsCore {
     sim::Bone bone = sim::Bone::Hips;
     double start_s = 0.0;
     double stiffness = 0.0;
+    double natural_hz = 0.0;
     sim::Vec3 baseline = sim::Vec3::Zero();  // B - A at the bone when the gift appeared
     double peak_m = 0.0;
   };
@@ -103,6 +104,7 @@ class PhysicsCore {
   void track_reactions();
   [[nodiscard]] sim::Vec3 bone_offset(sim::Bone b) const;  // B's centre of mass minus A's
   [[nodiscard]] double group_stiffness(sim::Bone b) const;
+  [[nodiscard]] double group_hz(sim::Bone b) const;
   void publish(std::int64_t now_us);
 
   const sim::Model* model_;

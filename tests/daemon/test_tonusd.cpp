@@ -1,0 +1,289 @@
+// tonusd as the user runs it: a real process, with the band simulator as a
+// real process, and the test as the avatar engine (a VMC receiver parsing
+// with liblo) and as a VMC performer. Loopback only; every run ends itself.
+#include <doctest/doctest.h>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
+
+#include "daemon_fixtures.hpp"
+#include "process.hpp"
+#include "tonus/host/daemon/pose_buffer.hpp"
+#include "tonus/host/vmc/pose_out.hpp"
+#include "tonus/host/vmc/sender.hpp"
+#include "tonus/sim/human_bones.hpp"
+#include "vmc_capture.hpp"
+
+using namespace tonus;
+using test::Process;
+using test::VmcCapture;
+
+namespace {
+
+std::string temp_path(const std::string& name) { return "/tmp/tonusd-test-" + std::to_string(::getpid()) + "-" + name; }
+
+nlohmann::json run_tonusd(const std::vector<std::string>& args, const std::string& name, std::string* log = nullptr) {
+  const std::string json = temp_path(name + ".json");
+  std::vector<std::string> a = args;
+  a.insert(a.end(), {"--json", json, "--no-control"});
+  Process p(TONUSD, a, temp_path(name + ".log"));
+  REQUIRE(p.started());
+  const int rc = p.wait(std::chrono::seconds(60));
+  if (log != nullptr) *log = p.output();
+  INFO(p.output());
+  REQUIRE(rc == 0);
+  std::ifstream in(json);
+  REQUIRE(in);
+  return nlohmann::json::parse(in);
+}
+
+std::string write_file(const std::string& name, const std::string& text) {
+  const std::string path = temp_path(name);
+  std::ofstream(path) << text;
+  return path;
+}
+
+double quat_norm(const test::OscMessage& m) {
+  return std::sqrt(m.numbers[3] * m.numbers[3] + m.numbers[4] * m.numbers[4] + m.numbers[5] * m.numbers[5] +
+                   m.numbers[6] * m.numbers[6]);
+}
+
+// The angle between two unit quaternions given as x y z w (either sign).
+double angle_between(const std::array<double, 4>& a, const std::array<double, 4>& b) {
+  const double dot = std::abs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]);
+  return 2.0 * std::acos(std::min(1.0, dot));
+}
+
+}  // namespace
+
+TEST_CASE("tonusd --demo: exits 0 with the summary's fields; the VMC output parses, every bone, unit quaternions") {
+  VmcCapture capture;
+  const nlohmann::json j =
+      run_tonusd({"--demo", "--seconds", "6", "--vmc-port", std::to_string(capture.port())}, "demo");
+  for (const char* key : {"ticks", "tick_p50_us", "tick_p99_us", "tick_max_us", "overruns", "vmc_bundles_sent",
+                          "band_reports_received", "band_reports_lost", "gifts", "stiffness_min", "stiffness_max"}) {
+    CHECK_MESSAGE(j.contains(key), key);
+  }
+  CHECK(j["ticks"].get<double>() > 5000);
+  CHECK(j["band_reports_received"].get<double>() > 1000);  // 500 Hz for most of 6 s
+  CHECK(j["vmc_bundles_sent"].get<double>() > 300);        // 60 Hz, two bundles a frame
+  REQUIRE(j["gifts"].size() == 4);
+  for (const auto& g : j["gifts"]) {
+    CHECK(g.contains("kind"));
+    CHECK(g.contains("bone"));
+    CHECK(g["stiffness"].get<double>() >= 0.0);
+    CHECK(g["peak_deflection_m"].get<double>() >= 0.0);
+  }
+  for (const char* group : {"right_arm", "left_arm", "trunk", "legs"}) {
+    CHECK(j["stiffness_min"][group].get<double>() < j["stiffness_max"][group].get<double>());  // it rose and fell
+  }
+
+  // The avatar engine's side: liblo parsed every datagram; frames start with
+  // /VMC/Ext/T and carry each of the 21 bones once, with unit quaternions.
+  CHECK(capture.unparsed() == 0);
+  CHECK(capture.max_datagram() <= 1500);
+  const std::vector<test::OscMessage> msgs = capture.messages();
+  std::vector<std::set<std::string>> frames;
+  int bad_norm = 0, objects = 0;
+  for (const auto& m : msgs) {
+    if (m.path == "/VMC/Ext/T") frames.emplace_back();
+    if (m.path == "/VMC/Ext/Bone/Pos" && !frames.empty()) {
+      REQUIRE(m.numbers.size() >= 7);
+      frames.back().insert(m.text);
+      if (std::abs(quat_norm(m) - 1.0) > 1e-4) ++bad_norm;
+    }
+    if (m.path == "/tonus/Object/Pos") ++objects;
+  }
+  REQUIRE(frames.size() > 300);
+  std::set<std::string> all;
+  for (const auto& b : sim::kBones) all.insert(std::string(b.name));
+  int complete = 0;
+  for (std::size_t f = 0; f + 1 < frames.size(); ++f) complete += frames[f] == all ? 1 : 0;
+  CHECK(complete == static_cast<int>(frames.size()) - 1);
+  CHECK(bad_norm == 0);
+  CHECK(objects > 0);  // the gifts are shown
+}
+
+TEST_CASE("tonusd: more co-contraction on the band means stiffer drives and a smaller sag under the same cube") {
+  const std::string gifts =
+      write_file("gifts.toml", "[demo]\ngifts = [ { at_s = 1.5, kind = \"cube\", bone = \"RightHand\" } ]\n");
+  const auto run = [&](const std::string& effort) {
+    return run_tonusd({"--demo", "--seconds", "4", "--config", gifts, "--tracker", "none", "--sim-synthetic", "step",
+                       "--sim-arg=--step-from", "--sim-arg=" + effort, "--sim-arg=--step-to", "--sim-arg=" + effort},
+                      "effort-" + effort);
+  };
+  const nlohmann::json low = run("0.1");
+  const nlohmann::json high = run("0.8");
+  REQUIRE(low["gifts"].size() == 1);
+  REQUIRE(high["gifts"].size() == 1);
+  const auto& gl = low["gifts"][0];
+  const auto& gh = high["gifts"][0];
+  MESSAGE("effort 0.1: stiffness " << gl["stiffness"] << ", " << gl["natural_hz"] << " Hz, sag "
+                                   << gl["peak_deflection_m"].get<double>() * 1e3 << " mm; effort 0.8: stiffness "
+                                   << gh["stiffness"] << ", " << gh["natural_hz"] << " Hz, sag "
+                                   << gh["peak_deflection_m"].get<double>() * 1e3 << " mm");
+  CHECK(gh["stiffness"].get<double>() > gl["stiffness"].get<double>() + 0.3);
+  CHECK(gh["natural_hz"].get<double>() > gl["natural_hz"].get<double>());
+  CHECK(gl["peak_deflection_m"].get<double>() > 0.003);
+  CHECK(gh["peak_deflection_m"].get<double>() < 0.7 * gl["peak_deflection_m"].get<double>());
+}
+
+TEST_CASE("tonusd: a CAN band over the simulated link streams too") {
+  const std::string cfg = write_file("can.toml", "[band]\nsim_link = \"can\"\n");
+  const nlohmann::json j = run_tonusd({"--seconds", "3", "--config", cfg, "--tracker", "none"}, "can");
+  CHECK(j["band_reports_received"].get<double>() > 500);
+  CHECK(j["band_reports_lost"].get<double>() < 10);
+  CHECK(j["band_device"].get<std::string>().find("firmware") != std::string::npos);
+}
+
+TEST_CASE("tonusd: the band killed mid-stream relaxes the stiffness to the safe default; a band back takes over") {
+  VmcCapture capture;
+  const std::string sock = temp_path("band.sock");
+  const std::vector<std::string> sim_args{"--synthetic", "step", "--step-from",  "0.8", "--step-to", "0.8",
+                                          "--seconds",   "60",   "--hid-socket", sock,  "--quiet"};
+  auto sim = std::make_unique<Process>(TONUS_BAND_SIM, sim_args, temp_path("sim1.log"));
+  REQUIRE(sim->started());
+  for (int i = 0; i < 200 && ::access(sock.c_str(), F_OK) != 0; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  const std::string json = temp_path("kill.json");
+  Process d(TONUSD,
+            {"--seconds", "8", "--band", "socket", "--band-socket", sock, "--tracker", "none", "--vmc-port",
+             std::to_string(capture.port()), "--vmc-rate", "200", "--no-control", "--json", json},
+            temp_path("kill.log"));
+  REQUIRE(d.started());
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  const std::int64_t kill_us = test::steady_us();
+  sim->kill(SIGKILL);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  ::unlink(sock.c_str());
+  const std::int64_t restart_us = test::steady_us();
+  sim = std::make_unique<Process>(TONUS_BAND_SIM, sim_args, temp_path("sim2.log"));
+  REQUIRE(d.wait(std::chrono::seconds(30)) == 0);
+  INFO(d.output());
+
+  const double safe = 0.3;  // band.safe_stiffness's default (docs/daemon.md)
+  double before = -1.0;
+  std::int64_t first_default_us = -1, resumed_us = -1;
+  double min_while_fresh = 1.0;
+  for (const auto& m : capture.messages()) {
+    if (m.path != "/tonus/Stiffness" || m.numbers.size() != 4) continue;
+    const double lo = *std::min_element(m.numbers.begin(), m.numbers.end());
+    const double hi = *std::max_element(m.numbers.begin(), m.numbers.end());
+    if (m.arrival_us < kill_us) before = lo;
+    if (m.arrival_us >= kill_us && m.arrival_us < kill_us + 90'000) min_while_fresh = std::min(min_while_fresh, lo);
+    if (m.arrival_us >= kill_us && first_default_us < 0 && std::abs(lo - safe) < 0.01 && std::abs(hi - safe) < 0.01) {
+      first_default_us = m.arrival_us;
+    }
+    if (m.arrival_us >= restart_us && resumed_us < 0 && lo > 0.6) resumed_us = m.arrival_us;
+  }
+  MESSAGE("stiffness before the kill " << before << "; the safe default reached " << (first_default_us - kill_us) / 1000
+                                       << " ms after the kill; resumed " << (resumed_us - restart_us) / 1000
+                                       << " ms after the restart");
+  CHECK(before > 0.6);
+  CHECK(min_while_fresh > 0.6);  // held while the last report is fresh
+  REQUIRE(first_default_us > 0);
+  // 100 ms of silence, then at most 100 ms to the default (one 5 ms output period and scheduling slack beside).
+  CHECK(first_default_us - kill_us <= 215'000);
+  CHECK(first_default_us - kill_us >= 100'000);
+  REQUIRE(resumed_us > 0);
+  CHECK(resumed_us - restart_us < 3'500'000);  // the reopen backoff is at most 2 s
+}
+
+TEST_CASE("tonusd: a VMC performer's stream is followed, held when it stops, eased to neutral; bad OSC is counted") {
+  VmcCapture capture;
+  const std::string json = temp_path("performer.json");
+  Process d(TONUSD,
+            {"--seconds", "5", "--band", "none", "--tracker", "vmc", "--vmc-mode", "performer", "--listen-port", "0",
+             "--vmc-port", std::to_string(capture.port()), "--vmc-rate", "100", "--no-control", "--json", json},
+            temp_path("performer.log"));
+  REQUIRE(d.started());
+  int listen_port = 0;
+  for (int i = 0; i < 300 && listen_port == 0; ++i) {
+    std::smatch m;
+    const std::string log = d.output();
+    if (std::regex_search(log, m, std::regex("mode on 127\\.0\\.0\\.1:([0-9]+)"))) listen_port = std::stoi(m[1]);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  REQUIRE(listen_port > 0);
+
+  // The performer raises the left arm 0.8 rad (about the forward axis) and holds it.
+  const sim::Model& model = test::daemon_humanoid();
+  std::array<double, sim::kMaxQpos> raised = model.qpos0;
+  const auto arm = static_cast<std::size_t>(model.bodies[sim::index(sim::Bone::LeftUpperArm)].qpos_adr);
+  const sim::Quat up(Eigen::AngleAxisd(0.8, sim::Vec3::UnitX()));
+  raised[arm] = up.w();
+  raised[arm + 1] = up.x();
+  raised[arm + 2] = up.y();
+  raised[arm + 3] = up.z();
+  vmc::VmcPose pose, neutral_pose;
+  REQUIRE(vmc::pose_from_qpos(model, raised, pose));
+  std::array<double, sim::kMaxQpos> neutral{};
+  daemon::neutral_qpos(model, raised, neutral);
+  REQUIRE(vmc::pose_from_qpos(model, neutral, neutral_pose));
+  vmc::SenderOptions so;
+  so.port = listen_port;
+  vmc::VmcSender sender(so);
+  REQUIRE(sender.ok());
+  for (int k = 0; k < 120; ++k) {  // 2 s at 60 Hz
+    sender.send(pose, k / 60.0, {}, nullptr);
+    std::this_thread::sleep_for(std::chrono::microseconds(16667));
+  }
+  const std::int64_t stop_us = test::steady_us();
+  // Bad input: 7 datagrams that are not OSC, 3 OSC messages nobody knows.
+  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  to.sin_port = htons(static_cast<std::uint16_t>(listen_port));
+  const auto send_raw = [&](const std::string& bytes) {
+    ::sendto(fd, bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
+  };
+  for (int i = 0; i < 7; ++i)
+    send_raw(i % 2 == 0 ? std::string("garbage!") : std::string("/VMC/Ext/Bone/Pos\0\0\0,sff", 24));
+  for (int i = 0; i < 3; ++i) send_raw(std::string("/tonus/nonsense\0,\0\0\0", 20));
+  ::close(fd);
+  REQUIRE(d.wait(std::chrono::seconds(30)) == 0);
+  INFO(d.output());
+
+  const auto rot = [](const sim::Quat& q) { return std::array<double, 4>{q.x(), q.y(), q.z(), q.w()}; };
+  const std::array<double, 4> want_raised = rot(pose.bone[sim::index(sim::Bone::LeftUpperArm)].rot);
+  const std::array<double, 4> want_neutral = rot(neutral_pose.bone[sim::index(sim::Bone::LeftUpperArm)].rot);
+  double live_err = 0.0, held_err = 0.0, neutral_err = 0.0;
+  int live_n = 0, held_n = 0, neutral_n = 0;
+  for (const auto& m : capture.messages()) {
+    if (m.path != "/VMC/Ext/Bone/Pos" || m.text != "LeftUpperArm") continue;
+    const std::array<double, 4> q{m.numbers[3], m.numbers[4], m.numbers[5], m.numbers[6]};
+    const std::int64_t dt = m.arrival_us - stop_us;
+    if (dt > -400'000 && dt < -100'000) {
+      live_err = std::max(live_err, angle_between(q, want_raised));
+      ++live_n;
+    } else if (dt > 50'000 && dt < 250'000) {
+      held_err = std::max(held_err, angle_between(q, want_raised));
+      ++held_n;
+    } else if (dt > 1'300'000) {
+      neutral_err = std::max(neutral_err, angle_between(q, want_neutral));
+      ++neutral_n;
+    }
+  }
+  MESSAGE("left upper arm: off the performer's by at most " << live_err << " rad while live, " << held_err
+                                                            << " rad held; off the neutral by " << neutral_err
+                                                            << " rad after easing");
+  REQUIRE(live_n > 10);
+  REQUIRE(held_n > 10);
+  REQUIRE(neutral_n > 10);
+  CHECK(live_err < 0.1);
+  CHECK(held_err < 0.1);
+  CHECK(neutral_err < 0.1);
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  CHECK(j["tracker_vmc_malformed"].get<int>() == 7);
+  CHECK(j["tracker_vmc_ignored"].get<int>() >= 3);
+}

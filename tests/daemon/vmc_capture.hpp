@@ -1,0 +1,120 @@
+// What tonusd sends, as an avatar engine receives it: a UDP socket on
+// 127.0.0.1 (an ephemeral port) whose datagrams are parsed by liblo itself
+// (lo_server_dispatch_data on a server bound to a Unix socket path, so
+// nothing listens on the network), every message kept with its arrival time.
+#pragma once
+
+#include <arpa/inet.h>
+#include <lo/lo.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace tonus::test {
+
+struct OscMessage {
+  std::string path;
+  std::string types;
+  std::string text;             // the first string argument, if any
+  std::vector<double> numbers;  // every int and float argument, in order
+  std::int64_t arrival_us = 0;  // steady clock
+};
+
+inline std::int64_t steady_us() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+class VmcCapture {
+ public:
+  VmcCapture() {
+    fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a);
+    socklen_t len = sizeof a;
+    ::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len);
+    port_ = ntohs(a.sin_port);
+    unix_path_ = "/tmp/tonus-vmc-capture-" + std::to_string(::getpid()) + "-" + std::to_string(port_);
+    ::unlink(unix_path_.c_str());
+    server_ = lo_server_new_with_proto(unix_path_.c_str(), LO_UNIX, nullptr);
+    lo_server_add_method(server_, nullptr, nullptr, &VmcCapture::on_message, this);
+    thread_ = std::thread([this] { run(); });
+  }
+  ~VmcCapture() {
+    stop_.store(true);
+    thread_.join();
+    lo_server_free(server_);
+    ::unlink(unix_path_.c_str());
+    ::close(fd_);
+  }
+  VmcCapture(const VmcCapture&) = delete;
+  VmcCapture& operator=(const VmcCapture&) = delete;
+
+  [[nodiscard]] int port() const { return port_; }
+  [[nodiscard]] std::vector<OscMessage> messages() const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return messages_;
+  }
+  [[nodiscard]] std::size_t datagrams() const { return datagrams_.load(); }
+  [[nodiscard]] std::size_t max_datagram() const { return max_datagram_.load(); }
+  [[nodiscard]] std::size_t unparsed() const { return unparsed_.load(); }
+
+ private:
+  static int on_message(const char* path, const char* types, lo_arg** argv, int argc, lo_message /*m*/, void* self) {
+    auto* c = static_cast<VmcCapture*>(self);
+    OscMessage msg;
+    msg.path = path;
+    msg.types = types;
+    msg.arrival_us = c->now_us_;
+    for (int i = 0; i < argc; ++i) {
+      switch (types[i]) {
+        case 's': msg.text = &argv[i]->s; break;
+        case 'f': msg.numbers.push_back(static_cast<double>(argv[i]->f)); break;
+        case 'i': msg.numbers.push_back(argv[i]->i); break;
+        case 'd': msg.numbers.push_back(argv[i]->d); break;
+        default: break;
+      }
+    }
+    const std::lock_guard<std::mutex> lock(c->mutex_);
+    c->messages_.push_back(std::move(msg));
+    return 0;
+  }
+
+  void run() {
+    std::vector<unsigned char> buf(65536);
+    while (!stop_.load()) {
+      pollfd p{fd_, POLLIN, 0};
+      if (::poll(&p, 1, 20) <= 0) continue;
+      const ssize_t n = ::recv(fd_, buf.data(), buf.size(), 0);
+      if (n <= 0) continue;
+      now_us_ = steady_us();
+      ++datagrams_;
+      if (static_cast<std::size_t>(n) > max_datagram_.load()) max_datagram_.store(static_cast<std::size_t>(n));
+      if (lo_server_dispatch_data(server_, buf.data(), static_cast<std::size_t>(n)) <= 0) ++unparsed_;
+    }
+  }
+
+  int fd_ = -1;
+  int port_ = 0;
+  std::string unix_path_;
+  lo_server server_ = nullptr;
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  std::int64_t now_us_ = 0;
+  mutable std::mutex mutex_;
+  std::vector<OscMessage> messages_;
+  std::atomic<std::size_t> datagrams_{0}, max_datagram_{0}, unparsed_{0};
+};
+
+}  // namespace tonus::test
