@@ -9,8 +9,18 @@
 namespace tonus::daemon {
 namespace {
 
-// A node as the file spells it (for error messages).
+// A node as the file spells it (for error messages): strings in double
+// quotes, numbers as short as they round-trip.
 std::string node_text(const toml::node& n) {
+  if (const auto v = n.value_exact<std::string>()) return fmt::format("\"{}\"", *v);
+  if (n.is_floating_point()) return fmt::format("{}", *n.value<double>());
+  if (n.is_integer()) return fmt::format("{}", *n.value<std::int64_t>());
+  if (const auto v = n.value_exact<bool>()) return *v ? "true" : "false";
+  if (const toml::array* a = n.as_array()) {
+    std::string out = "[";
+    for (std::size_t i = 0; i < a->size(); ++i) out += (i > 0 ? ", " : "") + node_text((*a)[i]);
+    return out + "]";
+  }
   std::ostringstream o;
   n.visit([&o](const auto& v) { o << v; });
   return o.str();
