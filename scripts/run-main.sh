@@ -7,6 +7,12 @@ cd "$(dirname "$0")/.."
 cmake --preset release >/dev/null
 cmake --build --preset release
 
+# tonusd, the host daemon, on embedded defaults: the band simulator spawned
+# with a co-contraction that rises and falls, the bundled CMU walk as the
+# tracker, a ball and cubes thrown on a schedule, VMC sent to 127.0.0.1:39539
+# (any avatar engine or OSC receiver there sees it); then its summary.
+build/release/bin/tonusd --demo --seconds 20 --json build/release/tonusd_demo.json
+
 # A simulated band stream pushed through the USB-HID and CAN bindings over
 # lossy links and decoded back, with every message accounted for.
 build/release/bin/tonus demo --seconds 5 --loss 0.01 --duplication 0.002 --reorder 0.002 --seed 1
