@@ -16,6 +16,7 @@
 
 #include "daemon_fixtures.hpp"
 #include "process.hpp"
+#include "tonus/host/control/client.hpp"
 #include "tonus/host/daemon/pose_buffer.hpp"
 #include "tonus/host/vmc/pose_out.hpp"
 #include "tonus/host/vmc/sender.hpp"
@@ -286,4 +287,102 @@ TEST_CASE("tonusd: a VMC performer's stream is followed, held when it stops, eas
   const nlohmann::json j = nlohmann::json::parse(in);
   CHECK(j["tracker_vmc_malformed"].get<int>() == 7);
   CHECK(j["tracker_vmc_ignored"].get<int>() >= 3);
+}
+
+TEST_CASE("tonusd: the control API spawns gifts, overrides and releases the stiffness, reports status; tonus ctl too") {
+  VmcCapture capture;
+  Process d(TONUSD,
+            {"--seconds", "6", "--tracker", "none", "--control-port", "0", "--vmc-port", std::to_string(capture.port()),
+             "--vmc-rate", "200"},
+            temp_path("control.log"));
+  REQUIRE(d.started());
+  int port = 0;
+  for (int i = 0; i < 300 && port == 0; ++i) {
+    std::smatch m;
+    const std::string log = d.output();
+    if (std::regex_search(log, m, std::regex("control: http://127\\.0\\.0\\.1:([0-9]+)/status")))
+      port = std::stoi(m[1]);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  REQUIRE(port > 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // the band connects
+  control::ControlClient client("127.0.0.1", port, 2);
+  const control::ClientReply st = client.status();
+  REQUIRE(st.status == 200);
+  CHECK(st.body["band"]["connected"].get<bool>());
+  CHECK(st.body["ticks"].get<double>() > 100);
+
+  control::GiftRequest cube;
+  cube.kind = control::GiftKind::cube;
+  cube.bone = sim::Bone::LeftHand;
+  const control::ClientReply g = client.gift(cube);
+  CHECK(g.status == 202);
+  CHECK(g.body["bone"] == "LeftHand");
+
+  const std::int64_t override_us = test::steady_us();
+  CHECK(client.set_stiffness(control::Levels{0.95, 0.95, 0.95, 0.95}).status == 202);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  CHECK(client.status().body["objects"].get<int>() == 1);
+  const std::int64_t release_us = test::steady_us();
+  CHECK(client.set_stiffness(std::nullopt).status == 202);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  CHECK(client.calibrate(control::CalibrationCommand::rest).status == 200);  // the simulated band starts a phase
+  CHECK(client.calibrate(control::CalibrationCommand::abort).status == 200);
+
+  // The same through `tonus ctl`, as a user types it.
+  Process ctl(TONUS_TOOL, {"ctl", "--port", std::to_string(port), "clear"}, temp_path("ctl.log"));
+  CHECK(ctl.wait(std::chrono::seconds(10)) == 0);
+  Process unreachable(TONUS_TOOL, {"ctl", "--port", "1", "status"}, temp_path("ctl2.log"));
+  CHECK(unreachable.wait(std::chrono::seconds(10)) == 2);
+  REQUIRE(d.wait(std::chrono::seconds(30)) == 0);
+  INFO(d.output());
+  CHECK(d.output().find("gift 1: a cube at the LeftHand") != std::string::npos);
+
+  // The override shows on the wire within 100 ms (rate limit 10/s from the band's level), then the band's again.
+  std::int64_t overridden_us = -1, released_us = -1;
+  for (const auto& m : capture.messages()) {
+    if (m.path != "/tonus/Stiffness" || m.numbers.size() != 4) continue;
+    const double lo = *std::min_element(m.numbers.begin(), m.numbers.end());
+    if (overridden_us < 0 && m.arrival_us > override_us && lo > 0.94) overridden_us = m.arrival_us;
+    if (released_us < 0 && m.arrival_us > release_us + 200'000 && lo < 0.9) released_us = m.arrival_us;
+  }
+  REQUIRE(overridden_us > 0);
+  CHECK(overridden_us - override_us < 150'000);
+  CHECK(released_us > 0);
+}
+
+TEST_CASE("tonusd: a bad config names the key and the value, and nothing starts") {
+  const struct {
+    const char* toml;
+    const char* expect;
+  } cases[] = {
+      {"[output]\nrate_hz = 1000\n", "output.rate_hz = 1000: must be 1..200"},
+      {"[band]\nsource = \"bluetooth\"\n", "band.source = \"bluetooth\""},
+      {"[tracker]\nlisten_prot = 1\n", "tracker.listen_prot: unknown key"},
+  };
+  int k = 0;
+  for (const auto& c : cases) {
+    const std::string cfg = write_file("bad" + std::to_string(k) + ".toml", c.toml);
+    Process p(TONUSD, {"--config", cfg, "--seconds", "5"}, temp_path("bad" + std::to_string(k++) + ".log"));
+    const int rc = p.wait(std::chrono::seconds(10));
+    INFO(p.output());
+    CHECK(rc == 2);
+    CHECK(p.output().find(c.expect) != std::string::npos);
+    CHECK(p.output().find("physics:") == std::string::npos);  // no thread was started
+  }
+  // A port in use is a start-up error too (exit 1), naming the keys.
+  VmcCapture busy;  // holds a UDP port on 127.0.0.1
+  Process p(TONUSD,
+            {"--tracker", "vmc", "--listen-port", std::to_string(busy.port()), "--seconds", "5", "--no-control"},
+            temp_path("busy.log"));
+  const int rc = p.wait(std::chrono::seconds(10));
+  INFO(p.output());
+  CHECK(rc == 1);
+  CHECK(p.output().find("tracker.listen_port = " + std::to_string(busy.port())) != std::string::npos);
+  // --print-config reads back.
+  Process pc(TONUSD, {"--print-config"}, temp_path("printed.toml"));
+  REQUIRE(pc.wait(std::chrono::seconds(10)) == 0);
+  Process again(TONUSD, {"--config", temp_path("printed.toml"), "--print-config"}, temp_path("printed2.toml"));
+  REQUIRE(again.wait(std::chrono::seconds(10)) == 0);
+  CHECK(test::read_file(temp_path("printed.toml")) == test::read_file(temp_path("printed2.toml")));
 }

@@ -3,6 +3,7 @@
 
 #include <exception>
 
+#include "ctl_command.hpp"
 #include "experiment_command.hpp"
 #include "ik_command.hpp"
 #include "physics_demo.hpp"
@@ -104,7 +105,10 @@ int run(int argc, char** argv) {
   ik_cmd->add_option("--seconds", ik.seconds, "At most this much of the clip")->check(CLI::Range(0.1, 3600.0));
   ik_cmd->add_flag("-q,--quiet", ik.quiet, "No report on stdout");
 
+  tonus::tools::CtlOptions ctl;
+  CLI::App* ctl_cmd = tonus::tools::add_ctl_command(app, ctl);
   CLI11_PARSE(app, argc, argv);
+  if (ctl_cmd->parsed()) return tonus::tools::run_ctl_command(ctl);
   if (ik_cmd->parsed()) return tonus::tools::run_ik_command(ik);
   if (experiment_cmd->parsed()) return tonus::tools::run_experiment(experiment);
   if (zmp_cmd->parsed()) return tonus::tools::run_zmp_command(zmp);

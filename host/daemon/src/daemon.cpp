@@ -103,6 +103,22 @@ bool Daemon::start(std::string& error) {
   spdlog::info("physics: {:.0f} Hz, feedforward {}, VMC to {}:{} at {:.0f} Hz", config_.physics.rate_hz,
                to_string(config_.physics.feedforward), config_.output.host, config_.output.port,
                config_.output.rate_hz);
+  if (config_.control.enabled) {
+    control_ = std::make_unique<DaemonControl>(*this);
+    control_server_ = std::make_unique<control::ControlServer>(*control_);
+    const std::string e =
+        control_server_->start(config_.control.address, config_.control.port, config_.control.allow_remote);
+    if (!e.empty()) {
+      error = fmt::format("control.address = \"{}\", control.port = {}: {}", config_.control.address,
+                          config_.control.port, e);
+      control_server_.reset();
+      physics_->stop();
+      output_->stop();
+      tracker_->stop();
+      return false;
+    }
+    spdlog::info("control: http://{}:{}/status (tonus ctl)", config_.control.address, control_server_->port());
+  }
   band_->start();
   started_wall_s_ = wall_s();
   cpu_seconds_ = cpu_s();
@@ -112,6 +128,7 @@ bool Daemon::start(std::string& error) {
 void Daemon::stop() {
   if (!physics_) return;
   const bool was_running = started_wall_s_ > 0.0;
+  if (control_server_) control_server_->stop();
   band_->stop();
   tracker_->stop();
   output_->stop();

@@ -14,8 +14,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tonus/host/control/server.hpp"
 #include "tonus/host/daemon/band_input.hpp"
 #include "tonus/host/daemon/config.hpp"
+#include "tonus/host/daemon/control_handler.hpp"
 #include "tonus/host/daemon/physics_core.hpp"
 #include "tonus/host/daemon/physics_thread.hpp"
 #include "tonus/host/daemon/tracker_input.hpp"
@@ -70,6 +72,7 @@ class Daemon {
   [[nodiscard]] std::string summary_text() const;
 
   [[nodiscard]] int vmc_listen_port() const { return tracker_ ? tracker_->vmc_port() : 0; }
+  [[nodiscard]] int control_port() const { return control_server_ ? control_server_->port() : 0; }
   [[nodiscard]] const DaemonConfig& config() const { return config_; }
 
  private:
@@ -84,6 +87,8 @@ class Daemon {
   std::unique_ptr<BandInput> band_;
   std::unique_ptr<TrackerInput> tracker_;
   std::unique_ptr<VmcOutput> output_;
+  std::unique_ptr<DaemonControl> control_;
+  std::unique_ptr<control::ControlServer> control_server_;
   std::atomic<std::uint32_t> next_id_{1};
   double started_wall_s_ = 0.0;
   double run_seconds_ = 0.0;
