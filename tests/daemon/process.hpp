@@ -32,6 +32,7 @@ class Process {
     std::vector<std::string> argv_s{exe};
     argv_s.insert(argv_s.end(), args.begin(), args.end());
     std::vector<char*> argv;
+    argv.reserve(argv_s.size() + 1);
     for (auto& s : argv_s) argv.push_back(s.data());
     argv.push_back(nullptr);
     ok_ = posix_spawn(&pid_, exe.c_str(), &fa, nullptr, argv.data(), environ) == 0;

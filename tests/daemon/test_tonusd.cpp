@@ -47,7 +47,7 @@ nlohmann::json run_tonusd(const std::vector<std::string>& args, const std::strin
 }
 
 std::string write_file(const std::string& name, const std::string& text) {
-  const std::string path = temp_path(name);
+  std::string path = temp_path(name);
   std::ofstream(path) << text;
   return path;
 }

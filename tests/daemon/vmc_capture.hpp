@@ -14,6 +14,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -41,7 +42,7 @@ class VmcCapture {
     sockaddr_in a{};
     a.sin_family = AF_INET;
     a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    ::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a);
+    if (::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) fd_ = -1;
     socklen_t len = sizeof a;
     ::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len);
     port_ = ntohs(a.sin_port);
@@ -77,12 +78,29 @@ class VmcCapture {
     msg.path = path;
     msg.types = types;
     msg.arrival_us = c->now_us_;
+    // liblo's argument pointers are only 4-byte aligned (lo_arg wants 8): read the bytes.
     for (int i = 0; i < argc; ++i) {
+      const void* p = argv[i];
       switch (types[i]) {
-        case 's': msg.text = &argv[i]->s; break;
-        case 'f': msg.numbers.push_back(static_cast<double>(argv[i]->f)); break;
-        case 'i': msg.numbers.push_back(argv[i]->i); break;
-        case 'd': msg.numbers.push_back(argv[i]->d); break;
+        case 's': msg.text = static_cast<const char*>(p); break;
+        case 'f': {
+          float f = 0;
+          std::memcpy(&f, p, sizeof f);
+          msg.numbers.push_back(static_cast<double>(f));
+          break;
+        }
+        case 'i': {
+          std::int32_t v = 0;
+          std::memcpy(&v, p, sizeof v);
+          msg.numbers.push_back(v);
+          break;
+        }
+        case 'd': {
+          double v = 0;
+          std::memcpy(&v, p, sizeof v);
+          msg.numbers.push_back(v);
+          break;
+        }
         default: break;
       }
     }

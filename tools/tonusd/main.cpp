@@ -29,9 +29,7 @@ std::string exe_dir() {
   return ec ? std::string(".") : p.parent_path().string();
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   using namespace tonus::daemon;
   CLI::App app{"tonusd: EMG-set stiffness for a physics avatar that follows motion capture, sent out as VMC"};
   std::string config_path, json_path;
@@ -166,4 +164,15 @@ int main(int argc, char** argv) {
     }
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "tonusd: " << e.what() << "\n";
+    return 1;
+  }
 }

@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 
 #include <chrono>
+#include <cmath>
 #include <thread>
 
 #include <fmt/format.h>
@@ -402,9 +403,9 @@ std::string Daemon::summary_text() const {
   for (std::size_t i = 0; i < trace.size(); i += step) {
     const auto& p = trace[i];
     const double v = p[1].get<double>();
-    out +=
-        fmt::format("  {:6.1f} s  {:.2f} {:.2f} {:.2f} {:.2f}  {}\n", p[0].get<double>(), v, p[2].get<double>(),
-                    p[3].get<double>(), p[4].get<double>(), std::string(static_cast<std::size_t>(v * 40.0 + 0.5), '#'));
+    out += fmt::format("  {:6.1f} s  {:.2f} {:.2f} {:.2f} {:.2f}  {}\n", p[0].get<double>(), v, p[2].get<double>(),
+                       p[3].get<double>(), p[4].get<double>(),
+                       std::string(static_cast<std::size_t>(std::lround(v * 40.0)), '#'));
   }
   out += "gifts:\n";
   for (const auto& g : j["gifts"]) {

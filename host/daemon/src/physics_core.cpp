@@ -46,14 +46,16 @@ sim::Vec3 PhysicsCore::bone_offset(sim::Bone b) const {
   return controller_->sim_b().xcom[i] - controller_->sim_a().xcom[i];
 }
 
+int PhysicsCore::group_of(sim::Bone b) const { return config_.avatar.stiffness.bone_group[sim::index(b)]; }
+
 double PhysicsCore::group_stiffness(sim::Bone b) const {
-  const std::int8_t g = config_.avatar.stiffness.bone_group[sim::index(b)];
+  const int g = group_of(b);
   if (g < 0) return 0.0;
   return controller_->mapper().applied()[static_cast<std::size_t>(g)];
 }
 
 double PhysicsCore::group_hz(sim::Bone b) const {
-  const std::int8_t g = config_.avatar.stiffness.bone_group[sim::index(b)];
+  const int g = group_of(b);
   if (g < 0) return config_.avatar.stiffness.ungrouped.min_hz;
   const auto gi = static_cast<std::size_t>(g);
   return controller_->mapper().frequency_hz(gi, controller_->mapper().applied()[gi]);

@@ -134,57 +134,95 @@ void TrackerInput::run_bvh() {
 
 void TrackerInput::run_vmc() {
   Vmc& v = *vmc_;
-  PoseSample s;
-  v.receiver->set_handler([this, &v, &s](const vmc::ReceivedFrame& f) {
+  // A sender's frame comes in several bundles (the receiver reports each), so
+  // everything one receive() call decoded is merged and solved once.
+  reference::BodySample body;
+  reference::TrackerFrame trackers;
+  bool pending = false;
+  std::int64_t arrival_us = 0;
+  v.receiver->set_handler([&](const vmc::ReceivedFrame& f) {
     if (f.mode == vmc::ReceiverMode::performer) {
-      if (!v.retarget && f.skeleton_ready && v.receiver->skeleton()) {
-        reference::BodyRetargetBuild b = reference::BodyRetarget::create(model_, *v.receiver->skeleton());
-        if (!b.ok()) {
-          spdlog::warn("tracker: the VMC sender's skeleton cannot be retargeted: {}", b.error);
-          v.receiver->reset_skeleton();
-          return;
-        }
-        v.retarget = std::move(*b.retarget);
-        spdlog::info("tracker: VMC performer skeleton learnt (scale {:.3f})", v.retarget->scale());
+      for (std::size_t b = 0; b < sim::kBoneCount; ++b) {
+        if (!f.body.present[b]) continue;
+        body.present[b] = true;
+        body.local[b] = f.body.local[b];
       }
-      if (!v.retarget) return;
-      s.qpos = model_.qpos0;
-      v.retarget->solve(f.body, v.retarget_state, s.qpos);
+      if (f.body.root_present) {
+        body.root_present = true;
+        body.root_position = f.body.root_position;
+        body.root_rotation = f.body.root_rotation;
+      }
     } else {
-      reference::TrackerFrame frame = f.trackers;
-      frame.time_s = static_cast<double>(f.arrival_us) * 1e-6;
-      if (!v.ik) {
-        const reference::CalibrationResult raw = reference::calibrate(frame);
-        if (!raw.ok()) return;                                       // waiting for the head and both hands
-        v.scale = sim::HumanoidSpec{}.height_m / raw.body.height_m;  // tonusd drives the default humanoid
-        for (auto& p : frame.pose) p.pos_m *= v.scale;
-        const reference::CalibrationResult cal = reference::calibrate(frame);
-        if (!cal.ok()) return;
-        reference::IkCreated ik = reference::make_ik_model(model_, cal.body);
-        if (!ik.model) {
-          spdlog::warn("tracker: IK cannot be set up: {}", ik.error);
-          return;
-        }
-        v.ik = std::move(*ik.model);
-        spdlog::info("tracker: calibrated from the first full frame: performer {:.2f} m, scaled by {:.3f}",
-                     raw.body.height_m, v.scale);
-      } else {
-        for (auto& p : frame.pose) p.pos_m *= v.scale;
+      for (std::size_t t = 0; t < reference::kTrackerCount; ++t) {
+        if (f.trackers.pose[t].valid) trackers.pose[t] = f.trackers.pose[t];
       }
-      reference::solve_ik(*v.ik, v.ik_state, frame, v.ik_out);
-      s.qpos = v.ik_out.qpos;
     }
-    s.t_us = f.arrival_us;
-    count_frame(core_.push_pose(s));
+    arrival_us = f.arrival_us;
+    pending = true;
   });
+  PoseSample s;
   while (!stop_.load()) {
     v.receiver->receive(20);
-    const vmc::ReceiverCounters& c = v.receiver->counters();
-    const std::lock_guard<std::mutex> lock(mutex_);
-    status_.vmc_messages = c.messages;
-    status_.vmc_ignored = c.ignored;
-    status_.vmc_malformed = c.malformed;
+    {
+      const vmc::ReceiverCounters& c = v.receiver->counters();
+      const std::lock_guard<std::mutex> lock(mutex_);
+      status_.vmc_messages = c.messages;
+      status_.vmc_ignored = c.ignored;
+      status_.vmc_malformed = c.malformed;
+    }
+    if (!pending) continue;
+    pending = false;
+    s.t_us = arrival_us;
+    const bool solved = config_.vmc_mode == VmcMode::performer ? solve_body(body, s.qpos)
+                                                               : solve_trackers(trackers, arrival_us, s.qpos);
+    body = reference::BodySample{};
+    trackers = reference::TrackerFrame{};
+    if (solved) count_frame(core_.push_pose(s));
   }
+}
+
+bool TrackerInput::solve_body(const reference::BodySample& body, Qpos& qpos) {
+  Vmc& v = *vmc_;
+  if (!v.retarget && v.receiver->skeleton()) {
+    reference::BodyRetargetBuild b = reference::BodyRetarget::create(model_, *v.receiver->skeleton());
+    if (!b.ok()) {
+      spdlog::warn("tracker: the VMC sender's skeleton cannot be retargeted: {}", b.error);
+      v.receiver->reset_skeleton();
+      return false;
+    }
+    v.retarget = std::move(*b.retarget);
+    spdlog::info("tracker: VMC performer skeleton learnt (scale {:.3f})", v.retarget->scale());
+  }
+  if (!v.retarget) return false;
+  qpos = model_.qpos0;
+  v.retarget->solve(body, v.retarget_state, qpos);
+  return true;
+}
+
+bool TrackerInput::solve_trackers(reference::TrackerFrame frame, std::int64_t arrival_us, Qpos& qpos) {
+  Vmc& v = *vmc_;
+  frame.time_s = static_cast<double>(arrival_us) * 1e-6;
+  if (!v.ik) {
+    const reference::CalibrationResult raw = reference::calibrate(frame);
+    if (!raw.ok()) return false;                                 // waiting for the head and both hands
+    v.scale = sim::HumanoidSpec{}.height_m / raw.body.height_m;  // tonusd drives the default humanoid
+    for (auto& p : frame.pose) p.pos_m *= v.scale;
+    const reference::CalibrationResult cal = reference::calibrate(frame);
+    if (!cal.ok()) return false;
+    reference::IkCreated ik = reference::make_ik_model(model_, cal.body);
+    if (!ik.model) {
+      spdlog::warn("tracker: IK cannot be set up: {}", ik.error);
+      return false;
+    }
+    v.ik = std::move(*ik.model);
+    spdlog::info("tracker: calibrated from the first full frame: performer {:.2f} m, scaled by {:.3f}",
+                 raw.body.height_m, v.scale);
+  } else {
+    for (auto& p : frame.pose) p.pos_m *= v.scale;
+  }
+  reference::solve_ik(*v.ik, v.ik_state, frame, v.ik_out);
+  qpos = v.ik_out.qpos;
+  return true;
 }
 
 }  // namespace tonus::daemon

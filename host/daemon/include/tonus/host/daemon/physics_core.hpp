@@ -103,6 +103,7 @@ class PhysicsCore {
   void spawn(const Command& c);
   void track_reactions();
   [[nodiscard]] sim::Vec3 bone_offset(sim::Bone b) const;  // B's centre of mass minus A's
+  [[nodiscard]] int group_of(sim::Bone b) const;           // the bone's stiffness group, or avatar::kNoGroup
   [[nodiscard]] double group_stiffness(sim::Bone b) const;
   [[nodiscard]] double group_hz(sim::Bone b) const;
   void publish(std::int64_t now_us);

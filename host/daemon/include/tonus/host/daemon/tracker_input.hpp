@@ -16,7 +16,9 @@
 
 #include "tonus/host/daemon/config.hpp"
 #include "tonus/host/daemon/physics_core.hpp"
+#include "tonus/host/reference/body_retarget.hpp"
 #include "tonus/host/reference/clip_reference.hpp"
+#include "tonus/host/reference/trackers.hpp"
 
 namespace tonus::daemon {
 
@@ -46,6 +48,8 @@ class TrackerInput {
   void run_bvh();
   void run_vmc();
   void count_frame(bool pushed);
+  bool solve_body(const reference::BodySample& body, Qpos& qpos);
+  bool solve_trackers(reference::TrackerFrame frame, std::int64_t arrival_us, Qpos& qpos);
 
   TrackerConfig config_;
   const sim::Model& model_;
