@@ -386,3 +386,17 @@ TEST_CASE("tonusd: a bad config names the key and the value, and nothing starts"
   REQUIRE(again.wait(std::chrono::seconds(10)) == 0);
   CHECK(test::read_file(temp_path("printed.toml")) == test::read_file(temp_path("printed2.toml")));
 }
+
+TEST_CASE("tonusd: a candump log of a band session replays as the band") {
+  const std::string log = temp_path("band.candump");
+  Process sim(TONUS_BAND_SIM,
+              {"--synthetic", "step", "--step-from", "0.8", "--step-to", "0.8", "--seconds", "4", "--candump", log,
+               "--fast", "--quiet"},
+              temp_path("simdump.log"));
+  REQUIRE(sim.wait(std::chrono::seconds(30)) == 0);
+  const nlohmann::json j =
+      run_tonusd({"--seconds", "3", "--band", "candump", "--band-candump", log, "--tracker", "none"}, "candump");
+  CHECK(j["band_reports_received"].get<double>() > 300);  // the log's reports, at its own pace
+  CHECK(j["band_reports_lost"].get<double>() == 0);
+  CHECK(j["stiffness_max"]["right_arm"].get<double>() > 0.5);
+}

@@ -235,7 +235,11 @@ void BandInput::serve_pending(host::BandLink& link) {
 }
 
 void BandInput::run() {
-  host::ReconnectingBandLink link(make_opener());
+  // A lost band is looked for again at least every second (a replugged USB
+  // band re-enumerated, a restarted simulator reconnected).
+  host::ReconnectPolicy policy;
+  policy.max_retry = std::chrono::milliseconds(1000);
+  host::ReconnectingBandLink link(make_opener(), policy);
   auto next_sync = std::chrono::steady_clock::now();
   const auto sync_every = std::chrono::microseconds(static_cast<std::int64_t>(config_.time_sync_interval_s * 1e6));
   std::string last_error;

@@ -240,10 +240,12 @@ void Daemon::log_status() {
     s = last_;
   }
   spdlog::info(
-      "status: tick p50 {:.0f} us p99 {:.0f} us max {:.0f} us, overruns {} | band {} {} reports, {} lost | tracker "
-      "{:.0f} Hz ({}) | stiffness {:.2f} {:.2f} {:.2f} {:.2f} | objects {} | vmc {} frames",
-      f.p50_us, f.p99_us, f.max_us, f.overruns, b.connected ? "on" : "off", b.reports, b.lost, t.rate_hz,
-      to_string(s.pose_state), s.stiffness[0], s.stiffness[1], s.stiffness[2], s.stiffness[3], s.nobjects, o.frames);
+      "status: tick p50 {:.0f} us p99 {:.0f} us max {:.0f} us, overruns {} | band {} {} reports, {} lost, latency p50 "
+      "{:.1f} ms p99 {:.1f} ms | tracker {:.0f} Hz ({}) | stiffness {:.2f} {:.2f} {:.2f} {:.2f} | objects {} | vmc {} "
+      "frames",
+      f.p50_us, f.p99_us, f.max_us, f.overruns, b.connected ? "on" : "off", b.reports, b.lost,
+      f.band_latency_p50_us * 1e-3, f.band_latency_p99_us * 1e-3, t.rate_hz, to_string(s.pose_state), s.stiffness[0],
+      s.stiffness[1], s.stiffness[2], s.stiffness[3], s.nobjects, o.frames);
 }
 
 void Daemon::run_for(double seconds, const std::atomic<bool>& stop_flag, bool demo_gifts) {

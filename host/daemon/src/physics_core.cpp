@@ -173,6 +173,12 @@ void PhysicsCore::publish(std::int64_t now_us) {
   status_snapshots_.publish();
 }
 
+void PhysicsCore::close_interval(double& latency_p50_us, double& latency_p99_us) {
+  latency_p50_us = interval_latency_.quantile_us(0.5);
+  latency_p99_us = interval_latency_.quantile_us(0.99);
+  interval_latency_.clear();
+}
+
 void PhysicsCore::tick(std::int64_t now_us) {
   // read
   BandSample band;
@@ -180,7 +186,10 @@ void PhysicsCore::tick(std::int64_t now_us) {
     ++stats_.band_samples;
     stiffness_.on_report(band.arrival_us, band.levels);
     band_arrival_us_ = std::max(band_arrival_us_, band.arrival_us);
-    if (band.sampled_host_us > 0) band_latency_.add(static_cast<double>(now_us - band.sampled_host_us));
+    if (band.sampled_host_us > 0) {
+      band_latency_.add(static_cast<double>(now_us - band.sampled_host_us));
+      interval_latency_.add(static_cast<double>(now_us - band.sampled_host_us));
+    }
   }
   PoseSample* pose = nullptr;
   while ((pose = pose_.peek()) != nullptr) {

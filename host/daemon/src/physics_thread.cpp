@@ -42,7 +42,7 @@ constexpr bool kAddressSanitizer = false;
 
 }  // namespace
 
-PhysicsThread::PhysicsThread(PhysicsCore& core, const PacingConfig& config) : core_(core), config_(config) {}
+PhysicsThread::PhysicsThread(TickTarget& core, const PacingConfig& config) : core_(core), config_(config) {}
 
 PhysicsThread::~PhysicsThread() { stop(); }
 
@@ -89,9 +89,12 @@ void PhysicsThread::run() {
   started_.store(true, std::memory_order_release);
   const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / config_.rate_hz));
   std::int64_t next = now_ns() + period_ns;
+  std::uint64_t burst = 0;  // ticks run without sleeping (their deadline had passed)
   while (!stop_.load(std::memory_order_acquire)) {
     sleep_until_ns(next);
     const std::int64_t start = now_ns();
+    burst = start - next >= period_ns ? burst + 1 : 0;
+    if (burst > longest_burst_.load(std::memory_order_relaxed)) longest_burst_.store(burst, std::memory_order_relaxed);
     late_.add(static_cast<double>(start - next) * 1e-3);
     core_.tick(next / 1000);
     const std::int64_t end = now_ns();
@@ -116,6 +119,7 @@ void PhysicsThread::run() {
       f.p99_us = interval_cost_.quantile_us(0.99);
       f.max_us = interval_cost_.max_us();
       f.overruns = interval_overruns_;
+      core_.close_interval(f.band_latency_p50_us, f.band_latency_p99_us);
       interval_.publish();
       interval_cost_.clear();
       interval_overruns_ = 0;

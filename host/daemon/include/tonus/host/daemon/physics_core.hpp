@@ -51,7 +51,22 @@ struct CoreStats {
   Levels stiffness_max{0.0, 0.0, 0.0, 0.0};
 };
 
-class PhysicsCore {
+// What the paced thread ticks (PhysicsCore; a test's stand-in that stalls).
+class TickTarget {
+ public:
+  virtual ~TickTarget() = default;
+  virtual void tick(std::int64_t now_us) = 0;
+  // Called by the paced thread between ticks when it closes a status
+  // interval: the band latency of the interval (device sample -> tick), us.
+  virtual void close_interval(double& latency_p50_us, double& latency_p99_us) { latency_p50_us = latency_p99_us = 0.0; }
+
+ protected:
+  TickTarget() = default;
+  TickTarget(const TickTarget&) = default;
+  TickTarget& operator=(const TickTarget&) = default;
+};
+
+class PhysicsCore final : public TickTarget {
  public:
   // The model must outlive the core. nullptr and `error` when the config does not fit the model.
   static std::unique_ptr<PhysicsCore> create(const sim::Model& model, const PhysicsCoreConfig& config,
@@ -63,7 +78,8 @@ class PhysicsCore {
   bool push_command(const Command& c);
 
   // One tick at host time now_us (the tick's deadline).
-  void tick(std::int64_t now_us);
+  void tick(std::int64_t now_us) override;
+  void close_interval(double& latency_p50_us, double& latency_p99_us) override;
 
   // Consumer sides for the other threads: one snapshot buffer for the
   // output thread, one for the status (main) thread.
@@ -127,6 +143,7 @@ class PhysicsCore {
   std::array<std::uint32_t, sim::kMaxObjects> object_ids_{};  // the request id of each object slot
   std::array<GiftKind, sim::kMaxObjects> object_kinds_{};
   Histogram band_latency_{10.0, 20000};  // 10 us bins up to 200 ms
+  Histogram interval_latency_{10.0, 20000};
   std::int64_t band_arrival_us_ = 0;
   bool band_live_ = false;
   PoseState pose_state_ = PoseState::none;

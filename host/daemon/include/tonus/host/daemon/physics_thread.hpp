@@ -41,11 +41,12 @@ struct IntervalFigures {
   std::uint64_t ticks = 0;
   double p50_us = 0.0, p99_us = 0.0, max_us = 0.0;
   std::uint64_t overruns = 0;
+  double band_latency_p50_us = 0.0, band_latency_p99_us = 0.0;  // device sample -> tick
 };
 
 class PhysicsThread {
  public:
-  PhysicsThread(PhysicsCore& core, const PacingConfig& config);
+  PhysicsThread(TickTarget& core, const PacingConfig& config);
   ~PhysicsThread();
   PhysicsThread(const PhysicsThread&) = delete;
   PhysicsThread& operator=(const PhysicsThread&) = delete;
@@ -58,6 +59,8 @@ class PhysicsThread {
   [[nodiscard]] std::uint64_t ticks() const { return ticks_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t overruns() const { return overruns_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t skipped() const { return skipped_.load(std::memory_order_relaxed); }
+  // Most ticks ever run back to back (catching up after a late one).
+  [[nodiscard]] std::uint64_t longest_catch_up() const { return longest_burst_.load(std::memory_order_relaxed); }
   // The tick costs and wake-up lateness over the whole run: read after stop().
   [[nodiscard]] const Histogram& tick_cost() const { return cost_; }
   [[nodiscard]] const Histogram& wake_late() const { return late_; }
@@ -70,13 +73,13 @@ class PhysicsThread {
   void run();
   void setup_realtime();
 
-  PhysicsCore& core_;
+  TickTarget& core_;
   PacingConfig config_;
   std::thread thread_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> started_{false};
   RealtimeSetup rt_;
-  std::atomic<std::uint64_t> ticks_{0}, overruns_{0}, skipped_{0};
+  std::atomic<std::uint64_t> ticks_{0}, overruns_{0}, skipped_{0}, longest_burst_{0};
   Histogram cost_{1.0, 20000};  // 1 us bins up to 20 ms
   Histogram late_{1.0, 20000};
   Histogram interval_cost_{1.0, 20000};
