@@ -400,3 +400,71 @@ TEST_CASE("tonusd: a candump log of a band session replays as the band") {
   CHECK(j["band_reports_lost"].get<double>() == 0);
   CHECK(j["stiffness_max"]["right_arm"].get<double>() > 0.5);
 }
+
+TEST_CASE("tonusd: VMC trackers (a headset and two controllers) calibrate from a T-pose and drive the arms by IK") {
+  VmcCapture capture;
+  Process d(TONUSD,
+            {"--seconds", "5", "--band", "none", "--tracker", "vmc", "--vmc-mode", "trackers", "--listen-port", "0",
+             "--vmc-port", std::to_string(capture.port()), "--vmc-rate", "100", "--no-control"},
+            temp_path("trackers.log"));
+  REQUIRE(d.started());
+  int listen_port = 0;
+  for (int i = 0; i < 300 && listen_port == 0; ++i) {
+    std::smatch m;
+    const std::string log = d.output();
+    if (std::regex_search(log, m, std::regex("mode on 127\\.0\\.0\\.1:([0-9]+)"))) listen_port = std::stoi(m[1]);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  REQUIRE(listen_port > 0);
+  lo_address to = lo_address_new("127.0.0.1", std::to_string(listen_port).c_str());
+  // Internal frame (Z up, facing +X, left +Y) to Unity's (Y up, facing +Z, right +X): (x, y, z) -> (-y, z, x).
+  const auto send = [&](const char* path, const char* serial, double x, double y, double z) {
+    // Varargs: liblo reads each "f" as a double (C promotes floats) and sends it as a float.
+    lo_send(to, path, "sfffffff", serial, -y, z, x, 0.0, 0.0, 0.0, 1.0);
+  };
+  // 1.5 s standing in a T-pose, then 1.5 s with the right hand brought forward and down to the belly.
+  std::int64_t moved_us = 0;
+  for (int k = 0; k < 180; ++k) {
+    const bool moved = k >= 90;
+    if (moved && moved_us == 0) moved_us = test::steady_us();
+    send("/VMC/Ext/Hmd/Pos", "HMD", 0.0, 0.0, 1.62);
+    send("/VMC/Ext/Con/Pos", "LEFT", 0.0, 0.80, 1.42);
+    if (moved) {
+      send("/VMC/Ext/Con/Pos", "RIGHT", 0.35, -0.10, 1.05);
+    } else {
+      send("/VMC/Ext/Con/Pos", "RIGHT", 0.0, -0.80, 1.42);
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(16667));
+  }
+  lo_address_free(to);
+  REQUIRE(d.wait(std::chrono::seconds(30)) == 0);
+  INFO(d.output());
+  CHECK(d.output().find("calibrated from the first full frame") != std::string::npos);
+  // The right upper arm's direction (its rest one: Unity +X, the avatar's right), whatever its twist: near
+  // the rest while the hand is out, swung well away once the hand comes in.
+  const auto swing = [](const std::vector<double>& n) {
+    const sim::Quat q(n[6], n[3], n[4], n[5]);  // w x y z from the message's x y z w
+    const sim::Vec3 dir = q.normalized() * sim::Vec3::UnitX();
+    return std::acos(std::clamp(dir.x(), -1.0, 1.0));
+  };
+  double rest_turn = 0.0, moved_turn = 0.0;
+  int rest_n = 0, moved_n = 0;
+  for (const auto& m : capture.messages()) {
+    if (m.path != "/VMC/Ext/Bone/Pos" || m.text != "RightUpperArm") continue;
+    const double turn = swing(m.numbers);
+    if (m.arrival_us > moved_us - 600'000 && m.arrival_us < moved_us - 100'000) {
+      rest_turn = std::max(rest_turn, turn);
+      ++rest_n;
+    }
+    if (m.arrival_us > moved_us + 900'000 && m.arrival_us < moved_us + 1'400'000) {
+      moved_turn = std::min(moved_n == 0 ? 10.0 : moved_turn, turn);
+      ++moved_n;
+    }
+  }
+  MESSAGE("right upper arm: swung at most " << rest_turn << " rad from the T-pose with the hand out, at least "
+                                            << moved_turn << " rad with it at the belly");
+  REQUIRE(rest_n > 10);
+  REQUIRE(moved_n > 10);
+  CHECK(rest_turn < 0.6);  // the clavicle's share and the shoulder's height leave the arm a little off level
+  CHECK(moved_turn > rest_turn + 0.8);
+}
