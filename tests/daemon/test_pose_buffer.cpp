@@ -115,3 +115,18 @@ TEST_CASE("pose buffer: older samples are dropped and counted; a full ring keeps
   bad.delay_s = -1.0;
   CHECK(validate(bad).find("tracker.delay_ms = -1000") != std::string::npos);
 }
+
+TEST_CASE("pose buffer: a cut (a clip starting over) steps instead of sweeping across the gap") {
+  PoseBufferConfig c;
+  c.delay_s = 0.0;
+  PoseBuffer b(humanoid(), c);
+  b.push(pose_at(1'000'000, 1.0));
+  PoseSample next = pose_at(1'010'000, 0.0);
+  next.cut = true;
+  b.push(next);
+  Qpos out{};
+  CHECK(b.sample(1'005'000, out) == PoseState::live);
+  CHECK(out[adr(Bone::RightLowerArm)] == doctest::Approx(1.0));  // still the old take
+  CHECK(b.sample(1'010'000, out) == PoseState::live);
+  CHECK(out[adr(Bone::RightLowerArm)] == doctest::Approx(0.0));  // the new one, whole
+}

@@ -235,6 +235,18 @@ void PhysicsCore::tick(std::int64_t now_us) {
     e.flags = out.flags;
     emit(e);
   }
+  if ((out.flags & (avatar::kReferenceJump | avatar::kResetB | avatar::kResetA)) != 0) {
+    // A and B were put back on the reference: the reactions measure from here.
+    for (Reaction& r : reactions_) {
+      if (r.active) r.baseline = bone_offset(r.bone);
+    }
+  }
+  if ((out.flags & avatar::kReferenceJump) != 0) {
+    Event e;
+    e.kind = Event::Kind::reference_jump;
+    e.time_s = out.time_s;
+    emit(e);
+  }
   track_reactions();
 
   // write

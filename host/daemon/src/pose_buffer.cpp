@@ -114,6 +114,10 @@ PoseState PoseBuffer::live_pose(std::int64_t t_us, Qpos& out) const {
     const PoseSample& b = at(i);
     if (t_us <= b.t_us) {
       const PoseSample& a = at(i - 1);
+      if (b.cut) {  // a step: the old take until the new one starts
+        out = t_us < b.t_us ? a.qpos : b.qpos;
+        return PoseState::live;
+      }
       const double u = static_cast<double>(t_us - a.t_us) / static_cast<double>(b.t_us - a.t_us);
       interpolate_qpos(*model_, a.qpos, b.qpos, u, out);
       return PoseState::live;

@@ -1,6 +1,7 @@
 #include "tonus/host/daemon/tracker_input.hpp"
 
 #include <filesystem>
+#include <utility>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -112,10 +113,12 @@ void TrackerInput::run_bvh() {
   std::int64_t t_us = host::steady_now_us();
   std::size_t k = clip_.first_frame;
   PoseSample s;
+  bool cut = false;
   while (!stop_.load()) {
     if (k >= clip_.qpos.size()) {
       if (!config_.bvh_loop) return;  // the stream ends: the physics core holds, then eases to neutral
       k = clip_.first_frame;
+      cut = true;
       const std::lock_guard<std::mutex> lock(mutex_);
       ++status_.loops;
     }
@@ -126,6 +129,7 @@ void TrackerInput::run_bvh() {
     }
     s.t_us = t_us;
     s.qpos = clip_.qpos[k];
+    s.cut = std::exchange(cut, false);
     count_frame(core_.push_pose(s));
     ++k;
     t_us += dt_us;

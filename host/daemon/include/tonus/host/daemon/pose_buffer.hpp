@@ -27,6 +27,10 @@ using Qpos = std::array<double, sim::kMaxQpos>;
 struct PoseSample {
   std::int64_t t_us = 0;  // host steady clock, arrival (or the source's own time mapped to it)
   Qpos qpos{};
+  // A new take (a looping clip starting over): not interpolated from the
+  // sample before, so the reference steps and the controller resyncs to it
+  // instead of sweeping the body across the gap in one sample interval.
+  bool cut = false;
 };
 
 struct PoseBufferConfig {
