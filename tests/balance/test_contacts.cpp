@@ -45,7 +45,7 @@ TEST_CASE("contacts: a walk alternates single support with short double support,
   CHECK(p.double_support < p.frames / 4);
 }
 
-TEST_CASE("contacts: a run has flight phases and no double support; standing never lifts a foot") {
+TEST_CASE("contacts: a run has flight phases and no double support, standing never lifts a foot") {
   const Phases run = phases(test::shared_clip("dataset-2_run_normal_010.bvh"));
   MESSAGE("run: " << run.airborne << " airborne, " << run.double_support << " double of " << run.frames);
   CHECK(run.airborne > run.frames / 3);  // about half by a simple test (SOURCES.md)
@@ -55,7 +55,7 @@ TEST_CASE("contacts: a run has flight phases and no double support; standing nev
   CHECK(wave.double_support == wave.frames);
 }
 
-TEST_CASE("contacts: one-leg kicks stand on the left foot; jumps fly about a fifth of the time") {
+TEST_CASE("contacts: one-leg kicks stand on the left foot, jumps fly about a fifth of the time") {
   const Phases kick = phases(test::shared_clip("dataset-1_kick_normal_001.bvh"));
   MESSAGE("kick: left only " << kick.left << ", right only " << kick.right << " of " << kick.frames);
   CHECK(kick.left > kick.frames / 6);  // about 25 % left-foot-only (SOURCES.md)

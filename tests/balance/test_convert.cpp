@@ -76,7 +76,7 @@ TEST_CASE("convert: a leading T-pose is detected and excluded, a normal first fr
   }
 }
 
-TEST_CASE("convert: conventions are recognised by their names; Mixamo prefixes are ignored") {
+TEST_CASE("convert: conventions are recognised by their names, Mixamo prefixes are ignored") {
   CHECK(test::load(test::bundled_clip("cmu_02_walk.bvh")).mapping.map.convention.find("CMU") == 0);
   const test::Loaded bandai = test::load(test::shared_clip("dataset-1_walk_normal_001.bvh"));
   CHECK(bandai.mapping.map.convention.find("Bandai") == 0);
@@ -91,7 +91,7 @@ TEST_CASE("convert: conventions are recognised by their names; Mixamo prefixes a
         doctest::Approx(zmp_outside_total(test::load(test::bundled_clip("cmu_02_walk.bvh")).clip)));
 }
 
-TEST_CASE("convert: a mapping file overrides names; malformed or missing mappings are refused with the line") {
+TEST_CASE("convert: a mapping file overrides names, malformed or missing mappings are refused with the line") {
   motion::Clip c = test::load(test::shared_clip("dataset-1_walk_normal_001.bvh")).clip;
   const std::size_t thigh = *motion::find_joint(c, "UpperLeg_L");
   c.joints[thigh].name = "weird_thigh_name";
@@ -106,7 +106,7 @@ TEST_CASE("convert: a mapping file overrides names; malformed or missing mapping
   CHECK(map_skeleton(c, "LeftUpperLeg = no_such_joint").error.find("no_such_joint") != std::string::npos);
 }
 
-TEST_CASE("convert: skeletons without toes get a sole from the ankle; the analysis still runs") {
+TEST_CASE("convert: skeletons without toes get a sole from the ankle, the analysis still runs") {
   motion::Clip c = test::load(test::shared_clip("dataset-1_walk_normal_001.bvh")).clip;
   for (motion::Joint& j : c.joints) {
     if (j.name == "Toes_L" || j.name == "Toes_R") j.name += "_unmapped";

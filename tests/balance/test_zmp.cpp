@@ -96,7 +96,7 @@ TEST_CASE("ZMP of a cart-table (linear inverted pendulum) motion matches p = x -
   }
 }
 
-TEST_CASE("ZMP: free fall has none; the angular momentum rate shifts it by dL/(m g)") {
+TEST_CASE("ZMP: free fall has none, the angular momentum rate shifts it by dL/(m g)") {
   const MassModel m = make_mass_model(70.0, tonus::sim::Sex::male);
   const SegmentFrame s = place_segments(m, standing());
   std::array<Vec3, kSegmentParts> fall;

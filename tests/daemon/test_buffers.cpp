@@ -62,7 +62,7 @@ TEST_CASE("triple buffer: nothing new, nothing taken") {
   CHECK(tb.read_slot() == 7);
 }
 
-TEST_CASE("histogram quantiles match the sorted values to one bin; the overflow keeps the tail") {
+TEST_CASE("histogram quantiles match the sorted values to one bin, the overflow keeps the tail") {
   std::mt19937 rng(5);
   std::lognormal_distribution<double> dist(3.5, 0.6);  // tick-cost-like: ~33 us median, a long tail
   Histogram h(1.0, 200);

@@ -67,7 +67,7 @@ TEST_CASE("config: a bad value names the key and the value, and nothing is accep
   CHECK(load_config("/nonexistent/tonusd.toml", c).find("cannot open") != std::string::npos);
 }
 
-TEST_CASE("config: keys read over the defaults; the printed config reads back to the same values") {
+TEST_CASE("config: keys read over the defaults, the printed config reads back to the same values") {
   DaemonConfig c;
   REQUIRE(parse_config("[band]\nsource = \"can\"\ncan_interface = \"vcan0\"\nsafe_stiffness = [0.1, 0.2, 0.3, 0.4]\n"
                        "sim_args = [\"--swell-period\", \"7\"]\n"

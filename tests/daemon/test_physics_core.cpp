@@ -65,7 +65,7 @@ TEST_CASE("physics core: a stiffer performer's hand gives less under the same cu
   CHECK(stiff.peak_deflection_m < 0.7 * soft.peak_deflection_m);
 }
 
-TEST_CASE("physics core: band silence relaxes to the safe default; an override wins until released") {
+TEST_CASE("physics core: band silence relaxes to the safe default, an override wins until released") {
   std::string error;
   PhysicsCoreConfig cfg;
   cfg.avatar.stiffness.max_rate_per_s = 10.0;

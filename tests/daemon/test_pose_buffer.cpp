@@ -101,7 +101,7 @@ TEST_CASE("pose buffer: a stopped stream is held, eased to a neutral where it st
   CHECK(out[0] == doctest::Approx(humanoid().qpos0[0]));
 }
 
-TEST_CASE("pose buffer: older samples are dropped and counted; a full ring keeps the newest") {
+TEST_CASE("pose buffer: older samples are dropped and counted, a full ring keeps the newest") {
   PoseBuffer b(humanoid(), PoseBufferConfig{});
   b.push(pose_at(1000, 0.0));
   b.push(pose_at(500, 0.0));

@@ -17,7 +17,7 @@ TEST_CASE("stiffness: the safe default until the first report, then the report's
   CHECK(s.live(1'050'000));
 }
 
-TEST_CASE("stiffness: 100 ms without a report eases to the safe default within the next 100 ms; a report resumes") {
+TEST_CASE("stiffness: 100 ms without a report eases to the safe default within the next 100 ms, a report resumes") {
   StiffnessInputConfig c;
   StiffnessInput s(c);
   const Levels high{0.9, 0.9, 0.9, 0.9};
@@ -34,7 +34,7 @@ TEST_CASE("stiffness: 100 ms without a report eases to the safe default within t
   CHECK(s.at(5'000'001)[0] == 0.6);
 }
 
-TEST_CASE("stiffness: non-finite levels keep the last value; bad configs are named") {
+TEST_CASE("stiffness: non-finite levels keep the last value, bad configs are named") {
   StiffnessInput s(StiffnessInputConfig{});
   s.on_report(0, {0.7, 0.7, 0.7, 0.7});
   s.on_report(1000, {std::nan(""), 0.2, INFINITY, 0.1});

@@ -65,7 +65,7 @@ double angle_between(const std::array<double, 4>& a, const std::array<double, 4>
 
 }  // namespace
 
-TEST_CASE("tonusd --demo: exits 0 with the summary's fields; the VMC output parses, every bone, unit quaternions") {
+TEST_CASE("tonusd --demo: exits 0 with the summary's fields, the VMC output parses, every bone, unit quaternions") {
   VmcCapture capture;
   const nlohmann::json j =
       run_tonusd({"--demo", "--seconds", "6", "--vmc-port", std::to_string(capture.port())}, "demo");
@@ -145,7 +145,7 @@ TEST_CASE("tonusd: a CAN band over the simulated link streams too") {
   CHECK(j["band_device"].get<std::string>().find("firmware") != std::string::npos);
 }
 
-TEST_CASE("tonusd: the band killed mid-stream relaxes the stiffness to the safe default; a band back takes over") {
+TEST_CASE("tonusd: the band killed mid-stream relaxes the stiffness to the safe default, a band back takes over") {
   VmcCapture capture;
   const std::string sock = temp_path("band.sock");
   const std::vector<std::string> sim_args{"--synthetic", "step", "--step-from",  "0.8", "--step-to", "0.8",
@@ -198,7 +198,7 @@ TEST_CASE("tonusd: the band killed mid-stream relaxes the stiffness to the safe 
   CHECK(resumed_us - restart_us < 3'500'000);  // the reopen backoff is at most 2 s
 }
 
-TEST_CASE("tonusd: a VMC performer's stream is followed, held when it stops, eased to neutral; bad OSC is counted") {
+TEST_CASE("tonusd: a VMC performer's stream is followed, held when it stops, eased to neutral, bad OSC is counted") {
   VmcCapture capture;
   const std::string json = temp_path("performer.json");
   Process d(TONUSD,
@@ -289,7 +289,7 @@ TEST_CASE("tonusd: a VMC performer's stream is followed, held when it stops, eas
   CHECK(j["tracker_vmc_ignored"].get<int>() >= 3);
 }
 
-TEST_CASE("tonusd: the control API spawns gifts, overrides and releases the stiffness, reports status; tonus ctl too") {
+TEST_CASE("tonusd: the control API spawns gifts, overrides and releases the stiffness, reports status, tonus ctl too") {
   VmcCapture capture;
   Process d(TONUSD,
             {"--seconds", "6", "--tracker", "none", "--control-port", "0", "--vmc-port", std::to_string(capture.port()),

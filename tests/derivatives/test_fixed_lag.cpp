@@ -122,7 +122,7 @@ TEST_CASE("streaming outputs the smoother's states: within the noise of batch ka
   CHECK(rms_error(k.acc, ks.acc, 30, 210) < 0.1 * noise);
 }
 
-TEST_CASE("reset forgets the stream; FixedLag3 is three FixedLag") {
+TEST_CASE("reset forgets the stream, FixedLag3 is three FixedLag") {
   const double dt = 1.0 / 120;
   const std::vector<double> y = noisy_walk(120, 60, 4);
   auto one = FixedLag::create(dt, {}, 5).smoother;

@@ -36,7 +36,7 @@ TEST_CASE("defaults are valid and every bad parameter is named") {
   CHECK(to_string(Error::bad_cutoff) == "bad_cutoff");
 }
 
-TEST_CASE("the Kalman methods need three finite samples; the others name the first non-finite one") {
+TEST_CASE("the Kalman methods need three finite samples, the others name the first non-finite one") {
   const std::vector<double> y{kNaN, 1.0, kInf, 2.0, kNaN, kNaN};
   for (Method m : {Method::kalman_spline, Method::kalman}) {
     CHECK(differentiate(y, 0.01, Params{.method = m}).status.error == Error::too_few_finite_samples);
@@ -63,7 +63,7 @@ TEST_CASE("bad views are refused, outputs may alias the input") {
   for (std::size_t i = 0; i < 8; ++i) CHECK(x[i] == ref.pos[i]);
 }
 
-TEST_CASE("jerk density and cutoff are inverse; the map is q = sigma^2 dt (2 pi fc)^6") {
+TEST_CASE("jerk density and cutoff are inverse, the map is q = sigma^2 dt (2 pi fc)^6") {
   const double q = jerk_psd(0.002, 6.0, 1.0 / 120);
   CHECK(q == doctest::Approx(0.002 * 0.002 / 120 * std::pow(2 * std::numbers::pi * 6.0, 6)).epsilon(1e-14));
   CHECK(cutoff_from_jerk_psd(q, 0.002, 1.0 / 120) == doctest::Approx(6.0).epsilon(1e-13));

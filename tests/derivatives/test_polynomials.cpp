@@ -77,7 +77,7 @@ TEST_CASE("cubics: exact for the not-a-knot spline, central differences as their
   }
 }
 
-TEST_CASE("cubics: the smoother is exact in the interior; at the ends it bends them (jerk -> 0)") {
+TEST_CASE("cubics: the smoother is exact in the interior, at the ends it bends them (jerk -> 0)") {
   // (Exact in the interior of an infinite series: its response is flat to 5th order at 0 Hz.)
   const Signal s = polynomial({0.2, -1.0, 0.5, 3.0});
   const double jerk = 18.0;

@@ -56,7 +56,7 @@ TEST_CASE("rest then MVC calibrates every channel") {
   CHECK(normalise(live, 0, 0.0F) == 0.0F);
 }
 
-TEST_CASE("an MVC weaker than twice the rest level does not calibrate; a failed phase keeps the old values") {
+TEST_CASE("an MVC weaker than twice the rest level does not calibrate, a failed phase keeps the old values") {
   Calibrator cal;
   Calibration live = default_calibration(FrontEnd{});
   cal.start(phase(proto::CalibrationPhase::rest), 1000.0F, 0);
@@ -69,7 +69,7 @@ TEST_CASE("an MVC weaker than twice the rest level does not calibrate; a failed 
   CHECK(live.calibrated_mask() == 0);
 }
 
-TEST_CASE("electrode-off samples are excluded; a channel off the whole phase is left out") {
+TEST_CASE("electrode-off samples are excluded, a channel off the whole phase is left out") {
   Calibrator cal;
   Calibration live = default_calibration(FrontEnd{});
   cal.start(phase(proto::CalibrationPhase::rest), 1000.0F, 0);

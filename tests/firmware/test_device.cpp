@@ -222,7 +222,7 @@ TEST_CASE("bad input: malformed and unknown commands, out-of-range configuration
   }
 }
 
-TEST_CASE("config set, saved, and loaded after a reboot; factory reset erases it") {
+TEST_CASE("config set, saved, and loaded after a reboot, factory reset erases it") {
   Bench b(spec(Scenario::rest, 3.0F));
   hal::Board board = b.board();
   Device dev(board);
@@ -250,7 +250,7 @@ TEST_CASE("config set, saved, and loaded after a reboot; factory reset erases it
   CHECK(dev.config() == default_config(b.gen.front_end()));
 }
 
-TEST_CASE("a lost block is counted and flagged once; a repeated block is never processed twice") {
+TEST_CASE("a lost block is counted and flagged once, a repeated block is never processed twice") {
   Bench b(spec(Scenario::rest, 2.0F));
   hal::Board board = b.board();
   Device dev(board);
@@ -356,7 +356,7 @@ TEST_CASE("scripted faults raise their flags on their channels, at their times")
   CHECK(dev.stats().lost_blocks == 1);
 }
 
-TEST_CASE("clean synthetic scenarios raise no flags; a broken lead reads as electrode off") {
+TEST_CASE("clean synthetic scenarios raise no flags, a broken lead reads as electrode off") {
   for (Scenario s : {Scenario::rest, Scenario::ramp, Scenario::bursts, Scenario::hum}) {
     INFO(to_string(s));
     Bench b(spec(s, 4.0F));
@@ -383,7 +383,7 @@ TEST_CASE("clean synthetic scenarios raise no flags; a broken lead reads as elec
   CHECK(dev.last_report().levels[1] == 0);  // its pair relaxes rather than reading garbage
 }
 
-TEST_CASE("calibration over commands; the host disappearing mid-phase leaves a consistent device") {
+TEST_CASE("calibration over commands, the host disappearing mid-phase leaves a consistent device") {
   SynthSpec sp = spec(Scenario::ramp, 20.0F);
   Bench b(sp);
   hal::Board board = b.board();
@@ -434,7 +434,7 @@ TEST_CASE("calibration over commands; the host disappearing mid-phase leaves a c
   CHECK(dev.calibration().calibrated_mask() == 0xFF);
 }
 
-TEST_CASE("a co-contraction ramp through the whole device: levels rise with it; hysteresis stops the chatter") {
+TEST_CASE("a co-contraction ramp through the whole device: levels rise with it, hysteresis stops the chatter") {
   // The envelope of random EMG has an estimation noise of ~10 % at tau = 100 ms
   // (De Luca 1997), so report-to-report the level moves both ways; what must
   // hold is that it follows the ramp (rising 1 s means) and that the hysteresis
@@ -773,7 +773,7 @@ TEST_CASE("fault log: a stalled sampler is logged, read once, repeats merged, ov
   CHECK(out.entries[0].time_ms == 10 + 40 - fw::kFaultLogCapacity);  // the oldest kept
 }
 
-TEST_CASE("enter_bootloader: answered first, then the board's bootloader; refused where there is none") {
+TEST_CASE("enter_bootloader: answered first, then the board's bootloader, refused where there is none") {
   Bench b(spec(Scenario::rest, 2.0F));
   hal::Board board = b.board();
   Device dev(board);

@@ -71,7 +71,7 @@ TEST_CASE("a scripted co-contraction ramp gives a monotonic level without chatte
   }
 }
 
-TEST_CASE("groups take the maximum of their pairs; unused pairs feed nothing") {
+TEST_CASE("groups take the maximum of their pairs, unused pairs feed nothing") {
   proto::DeviceConfig cfg{};
   cfg.hysteresis = 0;
   cfg.dead_band = 0;

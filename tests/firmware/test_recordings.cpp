@@ -66,7 +66,7 @@ double percentile(std::vector<double> v, double p) {
 
 }  // namespace
 
-TEST_CASE("BioSPPy 1 kHz: rest and activity separate clearly in the envelope; rest raises no flags") {
+TEST_CASE("BioSPPy 1 kHz: rest and activity separate clearly in the envelope, rest raises no flags") {
   const sim::Recording rec = load("biosppy_emg_1.txt");
   CHECK(rec.sample_rate_hz == doctest::Approx(1000.0F));
   CHECK(rec.frames.size() == 63880);

@@ -182,7 +182,7 @@ TEST_CASE("enumeration as Linux does it") {
   CHECK_FALSE(dcd.hid_open);
 }
 
-TEST_CASE("bad control requests stall; replies never exceed wLength; ZLP when a short reply fills packets") {
+TEST_CASE("bad control requests stall, replies never exceed wLength, ZLP when a short reply fills packets") {
   FakeDcd dcd;
   DeviceCore core(dcd, 1);
   core.on_bus_reset();

@@ -126,7 +126,7 @@ TEST_CASE("HID link: bad reports are counted and never delivered") {
   CHECK(d.fresh.front() == std::make_pair(std::uint8_t{1}, std::uint16_t{0}));
 }
 
-TEST_CASE("CAN link: a heartbeat whose uptime went back marks a reboot; the stream after it is kept") {
+TEST_CASE("CAN link: a heartbeat whose uptime went back marks a reboot, the stream after it is kept") {
   test::FakeCanTransport t;
   const auto cycle = [&](std::uint16_t seq) {
     std::array<proto::CanFrame, proto::can::kMaxStreamFrames> frames{};

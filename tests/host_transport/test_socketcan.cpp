@@ -53,7 +53,7 @@ TEST_CASE("SocketCAN: every option's setsockopt result is checked") {
   CHECK(error.find("SO_TIMESTAMP") != std::string::npos);
 }
 
-TEST_CASE("SocketCAN: error frames are consumed and show bus-off; frames carry kernel receive times") {
+TEST_CASE("SocketCAN: error frames are consumed and show bus-off, frames carry kernel receive times") {
   Pair p;
   std::string error;
   auto t = host::SocketCanTransport::adopt(p.ours, error);

@@ -134,7 +134,7 @@ TEST_CASE("euler: at and near gimbal lock the angles still rebuild the rotation"
   }
 }
 
-TEST_CASE("euler: scale and sign of the quaternion do not matter; zero gives NaN") {
+TEST_CASE("euler: scale and sign of the quaternion do not matter, zero gives NaN") {
   std::mt19937 rng(8);
   for (const auto& [order, a] : kOrders) {
     const Eigen::Quaterniond q = random_rotation(rng);

@@ -70,7 +70,7 @@ TEST_CASE("fk: the channel order is the order of the product, first channel oute
   CHECK(near(tip_of(one_joint("Xrotation Zrotation Yrotation", "90 90 90", "1 0 0")), {0, 1, 0}));
 }
 
-TEST_CASE("fk: position channels replace the OFFSET component by component; rotations do not move the joint") {
+TEST_CASE("fk: position channels replace the OFFSET component by component, rotations do not move the joint") {
   const char* text =
       "HIERARCHY\nROOT R\n{\nOFFSET 5 5 5\nCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
       "JOINT C\n{\nOFFSET 7 8 9\nCHANNELS 2 Yposition Xrotation\n"

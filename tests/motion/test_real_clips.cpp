@@ -166,7 +166,7 @@ TEST_CASE("real clips: frame counts, frame times, joints and channel orders of S
   }
 }
 
-TEST_CASE("real clips: Bandai position channels equal the OFFSETs; joint_Root stays zero") {
+TEST_CASE("real clips: Bandai position channels equal the OFFSETs, joint_Root stays zero") {
   for (const Expected& e : kExpected) {
     if (std::string(e.name).starts_with("cmu_")) continue;
     CAPTURE(e.name);

@@ -104,7 +104,7 @@ TEST_CASE("losing any frame of a cycle loses that cycle and nothing else") {
   }
 }
 
-TEST_CASE("losing every envelope frame of a cycle loses the cycle; it does not pass for one sent without them") {
+TEST_CASE("losing every envelope frame of a cycle loses the cycle, it does not pass for one sent without them") {
   for (const std::uint8_t channels : {std::uint8_t{4}, std::uint8_t{8}, std::uint8_t{16}}) {
     CAPTURE(int{channels});
     const StreamMessage m = make_message(4, channels, 20);
@@ -256,7 +256,7 @@ TEST_CASE("command messages of every length survive segmentation") {
   CHECK(segment(std::span(too_long).first(8), Function::status, 4, frames, n) == Error::bad_type);
 }
 
-TEST_CASE("reassembly: a missing, repeated or foreign segment voids the message; index 0 restarts") {
+TEST_CASE("reassembly: a missing, repeated or foreign segment voids the message, index 0 restarts") {
   Request req{};
   REQUIRE(make_request(Opcode::set_config, 8, DeviceConfig{}, req) == Error::ok);
   std::array<std::uint8_t, kMaxMessageSize> bytes{};

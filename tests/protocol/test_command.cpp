@@ -67,7 +67,7 @@ DeviceInfo sample_info() {
 
 }  // namespace
 
-TEST_CASE("minor 1 additions: a minor-0 DeviceInfo still reads; the fault log round-trips and is checked") {
+TEST_CASE("minor 1 additions: a minor-0 DeviceInfo still reads, the fault log round-trips and is checked") {
   // A version 1.0 band answers with the 29-byte DeviceInfo: the appended fields read as zero.
   const DeviceInfo full = sample_info();
   std::array<std::uint8_t, DeviceInfo::kWireSize> bytes{};

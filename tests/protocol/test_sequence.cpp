@@ -32,7 +32,7 @@ TEST_CASE("a gap across the wrap is counted lost, and taken back when a late mes
   CHECK(t.lost() == 3);
 }
 
-TEST_CASE("messages older than the window are stale; large jumps resync") {
+TEST_CASE("messages older than the window are stale, large jumps resync") {
   SequenceTracker t;
   t.push(1000);
   t.push(1100);

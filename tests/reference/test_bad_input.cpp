@@ -126,7 +126,7 @@ TEST_CASE("reference: the path and the motion give the same configurations, and 
   CHECK(fig.contact_foot_z_m.p95 < 0.04);
 }
 
-TEST_CASE("reference: the checks catch a wrong answer (a tilted, shifted root; a straightened elbow)") {
+TEST_CASE("reference: the checks catch a wrong answer (a tilted, shifted root, a straightened elbow)") {
   const balance::Conversion conv = reference::test::load(reference::test::bundled_clip("cmu_02_walk.bvh"));
   const sim::Model& m = reference::test::humanoid();
   ClipReference r = clip_to_reference(m, conv.motion);

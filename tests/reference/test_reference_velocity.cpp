@@ -394,7 +394,7 @@ TEST_CASE("reference velocity: missing and broken frames are bridged, never NaN"
   CHECK(fill_err < 1e-3);
 }
 
-TEST_CASE("reference velocity: reset forgets the stream; the next is as a fresh instance's") {
+TEST_CASE("reference velocity: reset forgets the stream, the next is as a fresh instance's") {
   const sim::Model& m = humanoid();
   const Motion motion(m);
   const Setting s = kSettings[0];

@@ -101,7 +101,7 @@ TEST_CASE("vmc sender: bundles within 1500 bytes, the full bone set, OK and T fi
   CHECK(sender.counters().send_errors == 0);
 }
 
-TEST_CASE("vmc sender: objects and stiffness; a small datagram limit splits further") {
+TEST_CASE("vmc sender: objects and stiffness, a small datagram limit splits further") {
   vmc::test::UdpSocket sink;
   vmc::SenderOptions o;
   o.port = sink.port();

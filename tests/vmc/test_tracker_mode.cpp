@@ -124,7 +124,7 @@ TEST_CASE("vmc tracker mode: sides follow the head's facing") {
   CHECK(f.trackers[Tracker::left_hand].pos_m.y() < 0.0);
 }
 
-TEST_CASE("vmc tracker mode: controllers before the head wait; the map wins and reserves its roles") {
+TEST_CASE("vmc tracker mode: controllers before the head wait, the map wins and reserves its roles") {
   Target t({{"MAPPED-R", Tracker::right_hand}});
   // No head yet: the controller cannot be placed.
   const std::uint64_t before = t.receiver.counters().datagrams;

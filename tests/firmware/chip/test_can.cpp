@@ -75,7 +75,7 @@ TEST_CASE("bit timing: exact 1 Mbit/s (and slower rates) from the clocks the ban
   CHECK_FALSE(can_bit_timing(42000000U, 0U, btr));
 }
 
-TEST_CASE("with the crystal the bus runs at exactly 1 Mbit/s; without it the band stays off the bus") {
+TEST_CASE("with the crystal the bus runs at exactly 1 Mbit/s, without it the band stays off the bus") {
   SUBCASE("crystal and PLL") {
     fake::reset();
     model_rcc(true);

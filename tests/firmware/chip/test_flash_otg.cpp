@@ -134,7 +134,7 @@ TEST_CASE("OTG: resume after suspend is handled, and the band streams again with
   CHECK(dcd.hid_busy());
 }
 
-TEST_CASE("OTG: ENDPOINT_HALT stalls EP1 IN and drops its FIFO; clearing it resets the data toggle") {
+TEST_CASE("OTG: ENDPOINT_HALT stalls EP1 IN and drops its FIFO, clearing it resets the data toggle") {
   ConfiguredOtg otg_fs;
   OtgFsDcd& dcd = otg_fs.dcd;
   usb::DeviceCore& core = otg_fs.core;

@@ -122,7 +122,7 @@ TEST_CASE("collision: bad input gives no points") {
   }
 }
 
-TEST_CASE("collision: the output span limits the points; the deepest always comes first") {
+TEST_CASE("collision: the output span limits the points, the deepest always comes first") {
   // Cube on a palm: 4 points, one corner 1 mm deeper than the rest (tilted).
   const Shape cube = Shape::box({0.03, 0.03, 0.03});
   const Shape palm = Shape::box({0.05, 0.05, 0.01});
