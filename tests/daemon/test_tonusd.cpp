@@ -292,8 +292,8 @@ TEST_CASE("tonusd: a VMC performer's stream is followed, held when it stops, eas
 TEST_CASE("tonusd: the control API spawns gifts, overrides and releases the stiffness, reports status, tonus ctl too") {
   VmcCapture capture;
   Process d(TONUSD,
-            {"--seconds", "10", "--tracker", "none", "--control-port", "0", "--vmc-port", std::to_string(capture.port()),
-             "--vmc-rate", "200"},
+            {"--seconds", "10", "--tracker", "none", "--control-port", "0", "--vmc-port",
+             std::to_string(capture.port()), "--vmc-rate", "200"},
             temp_path("control.log"));
   REQUIRE(d.started());
   int port = 0;
