@@ -207,7 +207,7 @@ void run_selftest(SelftestResult& out, SelftestSink sink, void* context, TickCou
   out.lost_blocks = device.stats().lost_blocks;
 
   const ChainModel& m = device.chain();
-  const double fs = m.sample_rate_hz;
+  const double fs = static_cast<double>(m.sample_rate_hz);
   out.notch_depth_mdb = static_cast<std::int32_t>(std::lround(20000.0 * std::log10(magnitude(m.notch[0], 50.0, fs))));
   const double hp = magnitude(m.highpass[0], 20.0, fs) * magnitude(m.highpass[1], 20.0, fs);
   out.highpass_corner_mdb = static_cast<std::int32_t>(std::lround(20000.0 * std::log10(hp)));

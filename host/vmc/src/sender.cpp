@@ -13,6 +13,9 @@ namespace tonus::vmc {
 
 namespace {
 
+// liblo's LO_TT_IMMEDIATE is a C compound literal, which clang flags in C++.
+constexpr lo_timetag kImmediate{0U, 1U};
+
 // The OSC messages of one frame, in order. Each message is owned here until
 // a bundle takes it (a new message has no reference; lo_bundle_add_message
 // adds the one lo_bundle_free_recursive drops, freeing it).
@@ -160,7 +163,7 @@ bool VmcSender::send(const VmcPose& pose, double time_s, std::span<const VmcObje
     // started. A single message always fits (kMinDatagramBytes).
     std::size_t i = 0;
     while (i < items.size()) {
-      lo_bundle b = lo_bundle_new(LO_TT_IMMEDIATE);
+      lo_bundle b = lo_bundle_new(kImmediate);
       std::size_t length = kBundleHeaderBytes;
       std::size_t count = 0;
       for (; i < items.size(); ++i) {
