@@ -81,7 +81,8 @@ Daemon::~Daemon() { stop(); }
 bool Daemon::start(std::string& error) {
   // The tracker first: a bad clip or a port in use stops everything before any thread runs.
   if (!tracker_->start(error)) return false;
-  if (!output_->start(error)) {
+  // The output thread just below the physics thread (when real time is asked for at all).
+  if (!output_->start(error, config_.physics.realtime_priority > 1 ? config_.physics.realtime_priority - 1 : 0)) {
     tracker_->stop();
     return false;
   }

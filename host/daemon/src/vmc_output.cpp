@@ -1,5 +1,8 @@
 #include "tonus/host/daemon/vmc_output.hpp"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <vector>
 
 #include <fmt/format.h>
@@ -15,7 +18,7 @@ VmcOutput::VmcOutput(const OutputConfig& config, const sim::Model& model, Physic
 
 VmcOutput::~VmcOutput() { stop(); }
 
-bool VmcOutput::start(std::string& error) {
+bool VmcOutput::start(std::string& error, int realtime_priority) {
   if (!config_.enabled || thread_.joinable()) return true;
   vmc::SenderOptions o;
   o.host = config_.host;
@@ -28,7 +31,7 @@ bool VmcOutput::start(std::string& error) {
     return false;
   }
   stop_.store(false);
-  thread_ = std::thread([this] { run(); });
+  thread_ = std::thread([this, realtime_priority] { run(realtime_priority); });
   return true;
 }
 
@@ -42,7 +45,12 @@ OutputStatus VmcOutput::status() const {
   return status_;
 }
 
-void VmcOutput::run() {
+void VmcOutput::run(int realtime_priority) {
+  if (realtime_priority > 0) {
+    sched_param p{};
+    p.sched_priority = realtime_priority;
+    pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);  // refused without the capability: runs as it is
+  }
   const auto period = std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / config_.rate_hz));
   auto next = std::chrono::steady_clock::now();
   vmc::VmcPose pose;

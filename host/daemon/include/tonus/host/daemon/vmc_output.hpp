@@ -37,7 +37,9 @@ class VmcOutput {
   VmcOutput(const VmcOutput&) = delete;
   VmcOutput& operator=(const VmcOutput&) = delete;
 
-  bool start(std::string& error);  // false: the address or port is unusable (nothing started)
+  // false: the address or port is unusable (nothing started). `realtime_priority` > 0: the thread asks for
+  // SCHED_FIFO at it (below the physics thread's), so a busy machine delays the wire less.
+  bool start(std::string& error, int realtime_priority = 0);
   void stop();
 
   [[nodiscard]] OutputStatus status() const;
@@ -45,7 +47,7 @@ class VmcOutput {
   [[nodiscard]] const Histogram& report_to_wire() const { return report_to_wire_; }
 
  private:
-  void run();
+  void run(int realtime_priority);
 
   OutputConfig config_;
   const sim::Model& model_;
