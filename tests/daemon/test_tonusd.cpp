@@ -54,6 +54,18 @@ std::string write_file(const std::string& name, const std::string& text) {
   return path;
 }
 
+// The port a process logs (its first capture group), waited for up to 3 s; 0 if it never appears.
+int port_in_log(const Process& p, const char* pattern) {
+  const std::regex re(pattern);
+  for (int i = 0; i < 300; ++i) {
+    std::smatch m;
+    const std::string log = p.output();
+    if (std::regex_search(log, m, re)) return std::stoi(m[1]);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return 0;
+}
+
 double quat_norm(const test::OscMessage& m) {
   return std::sqrt(m.numbers[3] * m.numbers[3] + m.numbers[4] * m.numbers[4] + m.numbers[5] * m.numbers[5] +
                    m.numbers[6] * m.numbers[6]);
@@ -211,13 +223,7 @@ TEST_CASE("tonusd: a VMC performer's stream is followed, held when it stops, eas
              "--json", json},
             temp_path("performer.log"));
   REQUIRE(d.started());
-  int listen_port = 0;
-  for (int i = 0; i < 300 && listen_port == 0; ++i) {
-    std::smatch m;
-    const std::string log = d.output();
-    if (std::regex_search(log, m, std::regex("mode on 127\\.0\\.0\\.1:([0-9]+)"))) listen_port = std::stoi(m[1]);
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  const int listen_port = port_in_log(d, "mode on 127\\.0\\.0\\.1:([0-9]+)");
   REQUIRE(listen_port > 0);
 
   // The performer raises the left arm 0.8 rad (about the forward axis) and holds it.
@@ -301,14 +307,7 @@ TEST_CASE("tonusd: the control API spawns gifts, overrides and releases the stif
              std::to_string(capture.port()), "--vmc-rate", "200"},
             temp_path("control.log"));
   REQUIRE(d.started());
-  int port = 0;
-  for (int i = 0; i < 300 && port == 0; ++i) {
-    std::smatch m;
-    const std::string log = d.output();
-    if (std::regex_search(log, m, std::regex("control: http://127\\.0\\.0\\.1:([0-9]+)/status")))
-      port = std::stoi(m[1]);
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  const int port = port_in_log(d, "control: http://127\\.0\\.0\\.1:([0-9]+)/status");
   REQUIRE(port > 0);
   control::ControlClient client("127.0.0.1", port, 2);
   control::ClientReply st;
@@ -419,13 +418,7 @@ TEST_CASE("tonusd: VMC trackers (a headset and two controllers) calibrate from a
              "--listen-port", "0", "--vmc-port", std::to_string(capture.port()), "--vmc-rate", "100", "--no-control"},
             temp_path("trackers.log"));
   REQUIRE(d.started());
-  int listen_port = 0;
-  for (int i = 0; i < 300 && listen_port == 0; ++i) {
-    std::smatch m;
-    const std::string log = d.output();
-    if (std::regex_search(log, m, std::regex("mode on 127\\.0\\.0\\.1:([0-9]+)"))) listen_port = std::stoi(m[1]);
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  const int listen_port = port_in_log(d, "mode on 127\\.0\\.0\\.1:([0-9]+)");
   REQUIRE(listen_port > 0);
   lo_address to = lo_address_new("127.0.0.1", std::to_string(listen_port).c_str());
   // Internal frame (Z up, facing +X, left +Y) to Unity's (Y up, facing +Z, right +X): (x, y, z) -> (-y, z, x).

@@ -93,24 +93,18 @@ int run(int argc, char** argv) {
   }
   if (!log_level.empty()) cfg.log.level = log_level;
   // The enum flags last: parse_config validates the whole config, so the paths they need are set by now.
-  if (!band_source.empty()) {
-    const std::string text = fmt::format("[band]\nsource = \"{}\"\n", band_source);
-    if (const std::string e = parse_config(text, "--band", cfg); !e.empty()) {
-      std::cerr << "tonusd: " << e << "\n";
-      return 2;
-    }
-  }
-  if (!tracker_source.empty()) {
-    if (const std::string e =
-            parse_config(fmt::format("[tracker]\nsource = \"{}\"\n", tracker_source), "--tracker", cfg);
-        !e.empty()) {
-      std::cerr << "tonusd: " << e << "\n";
-      return 2;
-    }
-  }
-  if (!vmc_mode.empty()) {
-    if (const std::string e = parse_config(fmt::format("[tracker]\nvmc_mode = \"{}\"\n", vmc_mode), "--vmc-mode", cfg);
-        !e.empty()) {
+  const struct {
+    const std::string& value;
+    const char* table;
+    const char* key;
+    const char* flag;
+  } enum_flags[] = {{band_source, "band", "source", "--band"},
+                    {tracker_source, "tracker", "source", "--tracker"},
+                    {vmc_mode, "tracker", "vmc_mode", "--vmc-mode"}};
+  for (const auto& f : enum_flags) {
+    if (f.value.empty()) continue;
+    const std::string text = fmt::format("[{}]\n{} = \"{}\"\n", f.table, f.key, f.value);
+    if (const std::string e = parse_config(text, f.flag, cfg); !e.empty()) {
       std::cerr << "tonusd: " << e << "\n";
       return 2;
     }

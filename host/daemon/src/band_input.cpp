@@ -275,14 +275,7 @@ void BandInput::run() {
     }
     const host::LinkStats st = link.stats();
     const std::lock_guard<std::mutex> lock(mutex_);
-    status_.reports = st.delivered;
-    status_.lost = st.lost;
-    status_.late = st.late;
-    status_.duplicates = st.duplicates;
-    status_.restarts = st.restarts;
-    status_.disconnects = st.disconnects;
-    status_.reconnects = st.reconnects;
-    status_.decode_errors = st.decode_errors;
+    status_.link = st;
     if (sync_) {
       status_.clock_synced = sync_->ready();
       status_.clock_offset_us = sync_->ready() ? sync_->offset_us_at(static_cast<double>(host::steady_now_us())) : 0.0;

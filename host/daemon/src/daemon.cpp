@@ -244,7 +244,7 @@ void Daemon::log_status() {
       "status: tick p50 {:.0f} us p99 {:.0f} us max {:.0f} us, overruns {} | band {} {} reports, {} lost, latency p50 "
       "{:.1f} ms p99 {:.1f} ms | tracker {:.0f} Hz ({}) | stiffness {:.2f} {:.2f} {:.2f} {:.2f} | objects {} | vmc {} "
       "frames",
-      f.p50_us, f.p99_us, f.max_us, f.overruns, b.connected ? "on" : "off", b.reports, b.lost,
+      f.p50_us, f.p99_us, f.max_us, f.overruns, b.connected ? "on" : "off", b.link.delivered, b.link.lost,
       f.band_latency_p50_us * 1e-3, f.band_latency_p99_us * 1e-3, t.rate_hz, to_string(s.pose_state), s.stiffness[0],
       s.stiffness[1], s.stiffness[2], s.stiffness[3], s.nobjects, o.frames);
 }
@@ -313,9 +313,9 @@ nlohmann::json Daemon::status_json() const {
                {"connected", b.connected},
                {"live", s.band_live},
                {"device", b.device},
-               {"reports", b.reports},
-               {"lost", b.lost},
-               {"disconnects", b.disconnects},
+               {"reports", b.link.delivered},
+               {"lost", b.link.lost},
+               {"disconnects", b.link.disconnects},
                {"clock_synced", b.clock_synced},
                {"clock_drift_ppm", b.clock_drift_ppm},
                {"sim_pid", b.sim_pid}};
@@ -352,9 +352,9 @@ nlohmann::json Daemon::summary_json() const {
   j["vmc_bundles_sent"] = o.bundles;
   j["vmc_frames_sent"] = o.frames;
   j["vmc_send_errors"] = o.send_errors;
-  j["band_reports_received"] = b.reports;
-  j["band_reports_lost"] = b.lost;
-  j["band_disconnects"] = b.disconnects;
+  j["band_reports_received"] = b.link.delivered;
+  j["band_reports_lost"] = b.link.lost;
+  j["band_disconnects"] = b.link.disconnects;
   j["band_device"] = b.device;
   j["band_clock_synced"] = b.clock_synced;
   j["band_clock_drift_ppm"] = b.clock_drift_ppm;

@@ -37,6 +37,13 @@ bool PhysicsCore::push_command(const Command& c) {
   return commands_.try_enqueue(c) || count_drop(command_dropped_);
 }
 
+Event PhysicsCore::event(Event::Kind kind) const {
+  Event e;
+  e.kind = kind;
+  e.time_s = controller_->output().time_s;
+  return e;
+}
+
 void PhysicsCore::emit(const Event& e) {
   if (!events_.try_enqueue(e)) ++stats_.events_dropped;
 }
@@ -65,8 +72,7 @@ void PhysicsCore::spawn(const Command& c) {
   const avatar::SpawnResult r =
       c.gift == GiftKind::ball ? controller_->throw_ball(c.ball) : controller_->drop_cube(c.cube);
   const sim::Bone bone = c.gift == GiftKind::ball ? c.ball.target : c.cube.target;
-  Event e;
-  e.time_s = controller_->output().time_s;
+  Event e = event(Event::Kind::gift_spawned);
   e.id = c.id;
   e.gift = c.gift;
   e.bone = bone;
@@ -81,7 +87,6 @@ void PhysicsCore::spawn(const Command& c) {
     object_ids_[slot] = c.id;
     object_kinds_[slot] = c.gift;
   }
-  e.kind = Event::Kind::gift_spawned;
   e.stiffness = group_stiffness(bone);
   e.natural_hz = group_hz(bone);
   emit(e);
@@ -96,8 +101,7 @@ void PhysicsCore::spawn(const Command& c) {
 
 void PhysicsCore::apply(const Command& c) {
   ++stats_.commands;
-  Event e;
-  e.time_s = controller_->output().time_s;
+  Event e = event(Event::Kind::gifts_cleared);
   e.id = c.id;
   switch (c.kind) {
     case Command::Kind::gift: spawn(c); return;
@@ -128,9 +132,7 @@ void PhysicsCore::track_reactions() {
     const bool alive = obj.active && obj.generation == r.gift.generation;
     if (alive) r.peak_m = std::max(r.peak_m, (bone_offset(r.bone) - r.baseline).norm());
     if (!alive || now_s - r.start_s >= config_.reaction_window_s) {
-      Event e;
-      e.kind = Event::Kind::gift_reaction;
-      e.time_s = now_s;
+      Event e = event(Event::Kind::gift_reaction);
       e.id = r.id;
       e.gift = r.kind;
       e.bone = r.bone;
@@ -203,19 +205,14 @@ void PhysicsCore::tick(std::int64_t now_us) {
   const PoseState ps = pose_buffer_.sample(now_us, input_.reference.qpos);
   input_.reference.has_velocity = false;
   if (ps != pose_state_) {
-    Event e;
-    e.kind = Event::Kind::tracker_state;
-    e.time_s = controller_->output().time_s;
+    Event e = event(Event::Kind::tracker_state);
     e.pose_state = ps;
     emit(e);
     pose_state_ = ps;
   }
   const bool live = stiffness_.live(now_us);
   if (live != band_live_ && stiffness_.ever_received()) {
-    Event e;
-    e.kind = live ? Event::Kind::band_live : Event::Kind::band_stale;
-    e.time_s = controller_->output().time_s;
-    emit(e);
+    emit(event(live ? Event::Kind::band_live : Event::Kind::band_stale));
   }
   band_live_ = live;
   input_.stiffness = override_ ? *override_ : stiffness_.at(now_us);
@@ -229,9 +226,7 @@ void PhysicsCore::tick(std::int64_t now_us) {
   }
   if ((out.flags & (avatar::kResetA | avatar::kResetB)) != 0) {
     ++stats_.avatar_resets;
-    Event e;
-    e.kind = Event::Kind::avatar_reset;
-    e.time_s = out.time_s;
+    Event e = event(Event::Kind::avatar_reset);
     e.flags = out.flags;
     emit(e);
   }
@@ -242,10 +237,7 @@ void PhysicsCore::tick(std::int64_t now_us) {
     }
   }
   if ((out.flags & avatar::kReferenceJump) != 0) {
-    Event e;
-    e.kind = Event::Kind::reference_jump;
-    e.time_s = out.time_s;
-    emit(e);
+    emit(event(Event::Kind::reference_jump));
   }
   track_reactions();
 

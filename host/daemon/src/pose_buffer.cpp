@@ -146,7 +146,6 @@ PoseState PoseBuffer::sample(std::int64_t now_us, Qpos& out) {
         state = PoseState::easing;
       }
     } else {
-      neutral_qpos(*model_, out, neutral_);  // where the avatar would settle if the stream stopped now
       // Back from easing or neutral: blend from what was shown over recover_s.
       const bool returning = last_state_ == PoseState::easing || last_state_ == PoseState::neutral;
       if (returning) {

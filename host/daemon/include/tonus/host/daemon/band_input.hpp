@@ -26,15 +26,8 @@ namespace tonus::daemon {
 // it is not the real-time thread).
 struct BandStatus {
   bool connected = false;
-  std::string device;  // identity line of the last device met
-  std::uint64_t reports = 0;
-  std::uint64_t lost = 0;
-  std::uint64_t late = 0;
-  std::uint64_t duplicates = 0;
-  std::uint64_t restarts = 0;
-  std::uint64_t disconnects = 0;
-  std::uint64_t reconnects = 0;
-  std::uint64_t decode_errors = 0;
+  std::string device;    // identity line of the last device met
+  host::LinkStats link;  // reports delivered, lost, late, duplicates, restarts, disconnects, ...
   bool clock_synced = false;
   double clock_offset_us = 0.0;
   double clock_drift_ppm = 0.0;

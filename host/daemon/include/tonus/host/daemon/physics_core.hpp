@@ -114,6 +114,7 @@ class PhysicsCore final : public TickTarget {
     n.fetch_add(1, std::memory_order_relaxed);
     return false;
   }
+  [[nodiscard]] Event event(Event::Kind kind) const;  // stamped with the physics time
   void emit(const Event& e);
   void apply(const Command& c);
   void spawn(const Command& c);
