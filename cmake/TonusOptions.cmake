@@ -1,7 +1,8 @@
 # Project-wide options, warning sets and the freestanding target property.
 
 option(TONUS_TARGET_ARM "Cross build for the Cortex-M4F band (set by the arm preset)" OFF)
-option(TONUS_FUZZ "Build the libFuzzer targets (clang only, set by the fuzz preset)" OFF)
+option(TONUS_FUZZ "Also build the libFuzzer targets (clang only; the asan and fuzz presets)" OFF)
+option(TONUS_FUZZ_ONLY "Build only the libFuzzer targets and what they link (the fuzz preset)" OFF)
 option(TONUS_WERROR "Treat warnings as errors" ON)
 
 # Real mocap and EMG recordings (../shared/data beside the checkout) that tests

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Formatting and static analysis, both clean on the tree or this fails.
-# Needs the compile databases of the release (and, if present, fuzz) builds.
+# Needs the compile databases of the release build and, for the fuzz targets,
+# of the asan build (or a fuzz-only build) when present.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -19,7 +20,12 @@ tidy() {
 mapfile -t host_tus < <(git ls-files '*.cpp' | grep -vE '^tests/fuzz/|^firmware/targets/(cortex-m4|probe)/')
 mapfile -t fuzz_tus < <(git ls-files 'tests/fuzz/*.cpp')
 out=$(tidy build/release "${host_tus[@]}")
-if [ -d build/fuzz ]; then out+=$(tidy build/fuzz "${fuzz_tus[@]}"); fi
+for fuzz_build in build/asan build/fuzz; do
+  if [ -f $fuzz_build/compile_commands.json ] && grep -q fuzz_stream $fuzz_build/compile_commands.json; then
+    out+=$(tidy $fuzz_build "${fuzz_tus[@]}")
+    break
+  fi
+done
 if [ -n "$out" ]; then
   echo "$out"
   echo "lint: clang-tidy found problems" >&2
