@@ -105,6 +105,7 @@ void PhysicsThread::run() {
     next += period_ns;
     if (end > next) {
       overruns_.fetch_add(1, std::memory_order_relaxed);
+      if (end - start > period_ns) overruns_cost_.fetch_add(1, std::memory_order_relaxed);
       ++interval_overruns_;
       const std::int64_t behind = (end - next) / period_ns;  // whole periods already missed
       if (behind >= config_.max_catch_up_ticks) {

@@ -3,6 +3,8 @@
 // std::chrono::steady_clock reads), so sleeping never accumulates drift.
 //
 // Overruns: a tick that ends after the next tick's deadline is an overrun.
+// Those whose own cost exceeded the period are counted apart: the rest woke
+// late (the scheduler, or a virtual machine's host) or were catching up.
 // The next ticks then run back to back to catch up, but never more than
 // max_catch_up_ticks behind: beyond that the missed deadlines are skipped
 // (counted) and the schedule restarts from now, so a stall (a page fault, a
@@ -58,6 +60,8 @@ class PhysicsThread {
   [[nodiscard]] const RealtimeSetup& realtime() const { return rt_; }
   [[nodiscard]] std::uint64_t ticks() const { return ticks_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t overruns() const { return overruns_.load(std::memory_order_relaxed); }
+  // Overruns whose tick alone took longer than the period.
+  [[nodiscard]] std::uint64_t overruns_from_cost() const { return overruns_cost_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t skipped() const { return skipped_.load(std::memory_order_relaxed); }
   // Most ticks ever run back to back (catching up after a late one).
   [[nodiscard]] std::uint64_t longest_catch_up() const { return longest_burst_.load(std::memory_order_relaxed); }
@@ -79,7 +83,7 @@ class PhysicsThread {
   std::atomic<bool> stop_{false};
   std::atomic<bool> started_{false};
   RealtimeSetup rt_;
-  std::atomic<std::uint64_t> ticks_{0}, overruns_{0}, skipped_{0}, longest_burst_{0};
+  std::atomic<std::uint64_t> ticks_{0}, overruns_{0}, overruns_cost_{0}, skipped_{0}, longest_burst_{0};
   Histogram cost_{1.0, 20000};  // 1 us bins up to 20 ms
   Histogram late_{1.0, 20000};
   Histogram interval_cost_{1.0, 20000};
