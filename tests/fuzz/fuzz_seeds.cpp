@@ -116,6 +116,74 @@ constexpr const char* kBvhSeeds[] = {
     "1 2 3 45 +1 1e1 -2.5\n\n1 2 3 45 1 1E-3 .5\n-1 -2 -3 -45 -1 -1 -.5",
 };
 
+// OSC, written by hand (the seeds need no liblo): strings NUL-terminated and
+// padded to 4 bytes, big-endian int32 and float32 arguments.
+void osc_pad_string(std::vector<std::uint8_t>& out, const std::string& s) {
+  out.insert(out.end(), s.begin(), s.end());
+  do out.push_back(0);
+  while (out.size() % 4 != 0);
+}
+
+void osc_be32(std::vector<std::uint8_t>& out, std::uint32_t v) {
+  for (int shift = 24; shift >= 0; shift -= 8)
+    out.push_back(static_cast<std::uint8_t>(v >> static_cast<unsigned>(shift)));
+}
+
+std::vector<std::uint8_t> osc_message(const std::string& address, const std::string& name,
+                                      const std::vector<float>& floats) {
+  std::vector<std::uint8_t> m;
+  osc_pad_string(m, address);
+  osc_pad_string(m, "," + std::string(name.empty() ? "" : "s") + std::string(floats.size(), 'f'));
+  if (!name.empty()) osc_pad_string(m, name);
+  for (const float f : floats) {
+    std::uint32_t bits = 0;
+    std::memcpy(&bits, &f, sizeof bits);
+    osc_be32(m, bits);
+  }
+  return m;
+}
+
+std::vector<std::uint8_t> osc_bundle(const std::vector<std::vector<std::uint8_t>>& elements) {
+  std::vector<std::uint8_t> b;
+  osc_pad_string(b, "#bundle");
+  osc_be32(b, 0);
+  osc_be32(b, 1);  // "immediately"
+  for (const auto& e : elements) {
+    osc_be32(b, static_cast<std::uint32_t>(e.size()));
+    b.insert(b.end(), e.begin(), e.end());
+  }
+  return b;
+}
+
+// A VMC performer frame (every humanoid bone the retargeting needs) and a
+// tracker frame (a headset, two controllers, three trackers), in Unity's frame.
+std::vector<std::vector<std::uint8_t>> vmc_seeds() {
+  const std::vector<float> pose{0.0F, 0.9F, 0.0F, 0.0F, 0.0F, 0.0F, 1.0F};
+  std::vector<std::uint8_t> ok;  // /VMC/Ext/OK 1: a model is loaded
+  osc_pad_string(ok, "/VMC/Ext/OK");
+  osc_pad_string(ok, ",i");
+  osc_be32(ok, 1);
+  std::vector<std::vector<std::uint8_t>> performer{ok};
+  performer.push_back(osc_message("/VMC/Ext/T", "", {12.5F}));
+  performer.push_back(osc_message("/VMC/Ext/Root/Pos", "root", pose));
+  for (const char* bone :
+       {"Hips",          "Spine",         "Chest",        "UpperChest",   "Neck",          "Head",
+        "LeftShoulder",  "LeftUpperArm",  "LeftLowerArm", "LeftHand",     "RightShoulder", "RightUpperArm",
+        "RightLowerArm", "RightHand",     "LeftUpperLeg", "LeftLowerLeg", "LeftFoot",      "LeftToes",
+        "RightUpperLeg", "RightLowerLeg", "RightFoot",    "RightToes"}) {
+    performer.push_back(osc_message("/VMC/Ext/Bone/Pos", bone, {0.1F, 0.2F, 0.0F, 0.0F, 0.0F, 0.0F, 1.0F}));
+  }
+  std::vector<std::vector<std::uint8_t>> trackers{
+      osc_message("/VMC/Ext/Hmd/Pos", "HMD-1", {0, 1.6F, 0, 0, 0, 0, 1}),
+      osc_message("/VMC/Ext/Con/Pos", "LHR-L", {-0.3F, 1.2F, 0.2F, 0, 0, 0, 1}),
+      osc_message("/VMC/Ext/Con/Pos", "LHR-R", {0.3F, 1.2F, 0.2F, 0, 0, 0, 1}),
+      osc_message("/VMC/Ext/Tra/Pos", "T-waist", {0, 1.0F, 0, 0, 0, 0, 1}),
+      osc_message("/VMC/Ext/Tra/Pos", "T-lfoot", {-0.1F, 0.1F, 0, 0, 0, 0, 1}),
+      osc_message("/VMC/Ext/Tra/Pos", "T-rfoot", {0.1F, 0.1F, 0, 0, 0, 0, 1})};
+  return {osc_bundle(performer), osc_bundle(trackers), osc_message("/VMC/Ext/Root/Pos", "root", pose),
+          osc_bundle({osc_bundle(trackers), osc_message("/VMC/Ext/T", "", {13.0F})})};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -124,7 +192,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path root(argv[1]);
-  for (const char* t : {"stream", "command", "hid_descriptor", "can", "candump", "bvh", "device", "usb_control"})
+  for (const char* t : {"stream", "command", "hid_descriptor", "can", "candump", "bvh", "device", "usb_control", "vmc"})
     fs::create_directories(root / t);
   int n = 0;
 
@@ -217,6 +285,7 @@ int main(int argc, char** argv) {
     const auto* bytes = reinterpret_cast<const std::uint8_t*>(bvh);
     write(root / "bvh", n, {bytes, bytes + std::strlen(bvh)});
   }
+  for (const std::vector<std::uint8_t>& datagram : vmc_seeds()) write(root / "vmc", n, datagram);
   std::printf("fuzz_seeds: wrote %d seeds under %s\n", n, root.c_str());
   return 0;
 }

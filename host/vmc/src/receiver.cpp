@@ -428,6 +428,22 @@ int VmcReceiver::receive(int timeout_ms) {
   return decoded;
 }
 
+void VmcReceiver::decode(const unsigned char* datagram, std::size_t size, std::int64_t arrival_us) {
+  try {
+    State& s = *state_;
+    s.arrival_us = arrival_us;
+    if (size > s.buffer.size()) {
+      ++s.counters.datagrams;
+      ++s.counters.malformed;
+      return;
+    }
+    if (size > 0) std::memcpy(s.buffer.data(), datagram, size);
+    s.datagram(size);
+  } catch (...) {
+    // as receive(): the datagram is lost, the receiver lives on
+  }
+}
+
 const ReceiverCounters& VmcReceiver::counters() const { return state_->counters; }
 const SenderStatus& VmcReceiver::sender() const { return state_->status; }
 const std::optional<reference::SourceSkeleton>& VmcReceiver::skeleton() const { return state_->skeleton; }

@@ -16,6 +16,14 @@ namespace {
 // liblo's LO_TT_IMMEDIATE is a C compound literal, which clang flags in C++.
 constexpr lo_timetag kImmediate{0U, 1U};
 
+std::uint64_t fnv1a(std::uint64_t h, const unsigned char* p, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) {
+    h ^= p[i];
+    h *= 1099511628211ULL;
+  }
+  return h;
+}
+
 // The OSC messages of one frame, in order. Each message is owned here until
 // a bundle takes it (a new message has no reference; lo_bundle_add_message
 // adds the one lo_bundle_free_recursive drops, freeing it).
@@ -119,6 +127,7 @@ VmcSender::VmcSender(const SenderOptions& options) : options_(options) {
     error_ = "VMC send host is empty";
     return;
   }
+  scratch_.resize(options_.max_datagram_bytes);
   address_ = lo_address_new(options_.host.c_str(), std::to_string(options_.port).c_str());
   if (address_ == nullptr) error_ = "VMC sender: liblo refused the address " + options_.host;
 }
@@ -150,6 +159,11 @@ bool VmcSender::send(const VmcPose& pose, double time_s, std::span<const VmcObje
 
   if (!options_.bundle) {
     for (Frame::Item& it : items) {
+      std::size_t size = lo_message_length(it.msg, it.path);
+      scratch_.resize(std::max(scratch_.size(), size));
+      if (lo_message_serialise(it.msg, it.path, scratch_.data(), &size) != nullptr) {
+        counters_.wire_hash = fnv1a(counters_.wire_hash, scratch_.data(), size);
+      }
       if (lo_send_message(addr, it.path, it.msg) < 0) {
         note_error();
         continue;
@@ -174,7 +188,11 @@ bool VmcSender::send(const VmcPose& pose, double time_s, std::span<const VmcObje
         length += element;
         ++count;
       }
-      const std::size_t serialised = lo_bundle_length(b);
+      std::size_t serialised = lo_bundle_length(b);
+      scratch_.resize(std::max(scratch_.size(), serialised));
+      if (lo_bundle_serialise(b, scratch_.data(), &serialised) != nullptr) {
+        counters_.wire_hash = fnv1a(counters_.wire_hash, scratch_.data(), serialised);
+      }
       if (lo_send_bundle(addr, b) < 0) {
         note_error();
       } else {

@@ -18,6 +18,7 @@
 // wildcard only); liblo decodes the messages.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -101,6 +102,11 @@ class VmcReceiver {
   // how many datagrams it decoded. Never throws.
   int receive(int timeout_ms);
   static constexpr int kMaxDatagramsPerCall = 4096;
+
+  // Decodes one datagram as if it had arrived at arrival_us (host steady
+  // clock), through the same path as receive(): for replaying captures and
+  // for the fuzzer. Works without a socket. Never throws.
+  void decode(const unsigned char* datagram, std::size_t size, std::int64_t arrival_us);
 
   [[nodiscard]] const ReceiverCounters& counters() const;
   [[nodiscard]] const SenderStatus& sender() const;

@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "tonus/host/vmc/pose_out.hpp"
 
@@ -38,6 +39,9 @@ struct SenderCounters {
   std::uint64_t bytes = 0;        // OSC payload bytes sent
   std::uint64_t send_errors = 0;  // datagrams the socket refused
   std::uint64_t rejected = 0;     // frames not sent: a non-finite value in the pose or an object
+  // FNV-1a (64 bits) over every datagram's bytes, in order: two runs whose
+  // hashes match sent the same bytes (tonusd's replay checks this).
+  std::uint64_t wire_hash = 14695981039346656037ULL;
 };
 
 class VmcSender {
@@ -72,7 +76,8 @@ class VmcSender {
   std::string error_;
   std::string last_send_error_;
   SenderCounters counters_;
-  void* address_ = nullptr;  // lo_address (liblo stays out of this header)
+  std::vector<unsigned char> scratch_;  // a datagram serialised for wire_hash
+  void* address_ = nullptr;             // lo_address (liblo stays out of this header)
 };
 
 }  // namespace tonus::vmc
