@@ -4,18 +4,21 @@
 // its queues and reads its outputs as the other threads would.
 #include <doctest/doctest.h>
 
+#include <unistd.h>
+
 #include <chrono>
 #include <thread>
 
 #include "daemon_fixtures.hpp"
 #include "support/allocation_counter.hpp"
 #include "tonus/host/daemon/physics_thread.hpp"
+#include "tonus/host/daemon/recorder.hpp"
 #include "tonus/host/transport/host_clock.hpp"
 
 using namespace tonus;
 using namespace tonus::daemon;
 
-TEST_CASE("the physics loop allocates nothing: 2 s at 1 kHz with band, tracker, gifts and overrides") {
+TEST_CASE("the physics loop allocates nothing: 2 s at 1 kHz with band, tracker, gifts, overrides and recording") {
   REQUIRE(test::probe_allocation_counter() == 2);
   std::string error;
   PhysicsCoreConfig cfg;
@@ -25,6 +28,14 @@ TEST_CASE("the physics loop allocates nothing: 2 s at 1 kHz with band, tracker, 
   pace.realtime_priority = 0;
   pace.lock_memory = false;
   PhysicsThread thread(*core, pace);
+  // Recording too: the loop's side of it is a copy into preallocated queues.
+  // The writer thread (which allocates its chunks) starts after counting.
+  recording::Header header;
+  header.nq = test::daemon_humanoid().nq;
+  const std::string record_path = "/tmp/tonus-noalloc-" + std::to_string(::getpid()) + ".tonusrec";
+  auto recorder = Recorder::create(record_path, header, error);
+  REQUIRE(recorder);
+  core->set_recorder(recorder.get());
   // Everything the loop and this feeder need, made before counting.
   PoseSample pose;
   pose.qpos = test::daemon_humanoid().qpos0;
@@ -72,6 +83,13 @@ TEST_CASE("the physics loop allocates nothing: 2 s at 1 kHz with band, tracker, 
   IntervalFigures f;
   const bool got_interval = thread.take_interval(f);
   thread.stop();
+  recorder->start();
+  recorder->stop();
+  const RecorderStatus rs = recorder->status();
+  ::unlink(record_path.c_str());
+  MESSAGE(rs.ticks << " ticks recorded in " << rs.chunks << " chunks" << (rs.error.empty() ? "" : ": ") << rs.error);
+  CHECK(rs.error.empty());
+  CHECK(rs.ticks == thread.ticks());
   MESSAGE(thread.ticks() << " ticks, " << events << " events, " << snapshots << " snapshots read, "
                          << core->stats().band_samples << " band reports, " << core->stats().pose_samples
                          << " poses: " << allocations << " allocations");

@@ -43,6 +43,8 @@ class VmcCapture {
     a.sin_family = AF_INET;
     a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
     if (::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) fd_ = -1;
+    const int buffer_bytes = 8 << 20;  // a replay as fast as it goes sends bursts: lose none
+    ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUFFORCE, &buffer_bytes, sizeof buffer_bytes);
     socklen_t len = sizeof a;
     ::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len);
     port_ = ntohs(a.sin_port);
@@ -66,6 +68,11 @@ class VmcCapture {
   [[nodiscard]] std::vector<OscMessage> messages() const {
     const std::lock_guard<std::mutex> lock(mutex_);
     return messages_;
+  }
+  // Every datagram's bytes, in arrival order.
+  [[nodiscard]] std::vector<std::vector<unsigned char>> raw() const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return raw_;
   }
   [[nodiscard]] std::size_t datagrams() const { return datagrams_.load(); }
   [[nodiscard]] std::size_t max_datagram() const { return max_datagram_.load(); }
@@ -119,6 +126,10 @@ class VmcCapture {
       now_us_ = steady_us();
       ++datagrams_;
       if (static_cast<std::size_t>(n) > max_datagram_.load()) max_datagram_.store(static_cast<std::size_t>(n));
+      {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        raw_.emplace_back(buf.begin(), buf.begin() + n);
+      }
       if (lo_server_dispatch_data(server_, buf.data(), static_cast<std::size_t>(n)) <= 0) ++unparsed_;
     }
   }
@@ -132,6 +143,7 @@ class VmcCapture {
   std::int64_t now_us_ = 0;
   mutable std::mutex mutex_;
   std::vector<OscMessage> messages_;
+  std::vector<std::vector<unsigned char>> raw_;
   std::atomic<std::size_t> datagrams_{0}, max_datagram_{0}, unparsed_{0};
 };
 

@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
+#include <utility>
 
 #include <fmt/format.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
@@ -32,7 +34,8 @@ std::string exe_dir() {
 int run(int argc, char** argv) {
   using namespace tonus::daemon;
   CLI::App app{"tonusd: EMG-set stiffness for a physics avatar that follows motion capture, sent out as VMC"};
-  std::string config_path, json_path;
+  std::string config_path, json_path, record_path, replay_path;
+  double speed = 1.0;
   bool demo = false, print_config = false, no_realtime = false, no_control = false;
   double seconds = -1.0;
   // Flags that override the file (each names its key in docs/daemon.md).
@@ -46,6 +49,10 @@ int run(int argc, char** argv) {
   app.add_option("--seconds", seconds, "run this long, then exit (default: --demo's demo.seconds, else until Ctrl-C)");
   app.add_option("--json", json_path, "write the run's summary as JSON to FILE at exit");
   app.add_flag("--print-config", print_config, "print the effective configuration as TOML and exit");
+  app.add_option("--record", record_path, "record every input to FILE, for --replay (docs/recording.md)");
+  app.add_option("--replay", replay_path, "replay a recording: the same outputs, bit for bit, then exit");
+  app.add_option("--speed", speed, "--replay's pace: x the recorded speed (0: as fast as it goes)")
+      ->check(CLI::Range(0.0, 1000.0));
   app.add_option("--band", band_source, "band.source: sim, socket, hid, can, candump, none");
   app.add_option("--band-socket", band_socket, "band.sim_socket: a tonus-band-sim serving --hid-socket PATH");
   app.add_option("--band-candump", candump_path, "band.candump_path: a candump log to replay");
@@ -68,6 +75,24 @@ int run(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   DaemonConfig cfg;
+  std::optional<recording::Reader> replay;
+  if (!replay_path.empty()) {
+    // The physics must be the recording's: only the output, control and log settings may change.
+    for (const auto& [set, flag] :
+         {std::pair{!config_path.empty(), "--config"}, std::pair{demo, "--demo"},
+          std::pair{rate_hz >= 0.0, "--rate-hz"}, std::pair{!record_path.empty(), "--record"}}) {
+      if (set) {
+        std::cerr << "tonusd: " << flag << " cannot go with --replay (the recording holds its configuration)\n";
+        return 2;
+      }
+    }
+    std::string error;
+    replay = Daemon::open_recording(replay_path, cfg, error);
+    if (!replay) {
+      std::cerr << "tonusd: replay: " << error << "\n";
+      return 2;
+    }
+  }
   if (!config_path.empty()) {
     if (const std::string e = load_config(config_path, cfg); !e.empty()) {
       std::cerr << "tonusd: " << e << "\n";
@@ -123,6 +148,15 @@ int run(int argc, char** argv) {
     std::cout << to_toml(cfg);
     return 0;
   }
+  if (!record_path.empty()) {
+    // Run on exactly what the recording's TOML reads back as, so a replay builds the same core.
+    DaemonConfig reread;
+    if (const std::string e = parse_config(to_toml(cfg), "the effective configuration", reread); !e.empty()) {
+      std::cerr << "tonusd: " << e << "\n";
+      return 2;
+    }
+    cfg = reread;
+  }
 
   auto logger = spdlog::stderr_color_mt("tonusd");
   spdlog::set_default_logger(logger);
@@ -141,6 +175,11 @@ int run(int argc, char** argv) {
     std::cerr << "tonusd: " << error << "\n";
     return 2;
   }
+  if (!record_path.empty() && !d->record_to(record_path, error)) {
+    std::cerr << "tonusd: " << error << "\n";
+    return 1;
+  }
+  if (replay) d->replay_from(std::move(*replay), speed);
   if (!d->start(error)) {
     std::cerr << "tonusd: " << error << "\n";
     return 1;
@@ -149,6 +188,25 @@ int run(int argc, char** argv) {
   d->run_for(run_s, g_stop, demo);
   d->stop();
   std::cout << d->summary_text();
+  int status = 0;
+  if (const ReplayDriver* r = d->replay()) {
+    const ReplayStatus rs = r->status();
+    switch (rs.end) {
+      case ReplayEnd::finished: break;
+      case ReplayEnd::truncated:
+        std::cerr << "tonusd: replay: the recording ends inside a chunk (the recording daemon was stopped hard?); "
+                     "replayed its "
+                  << rs.chunks << " whole chunks\n";
+        break;
+      case ReplayEnd::running:
+      case ReplayEnd::stopped: break;  // --seconds or a signal ended it
+      case ReplayEnd::corrupt:
+      case ReplayEnd::diverged:
+        std::cerr << "tonusd: replay " << to_string(rs.end) << ": " << rs.error << "\n";
+        status = 1;
+        break;
+    }
+  }
   if (!json_path.empty()) {
     std::ofstream out(json_path);
     out << d->summary_json().dump(2) << "\n";
@@ -157,7 +215,7 @@ int run(int argc, char** argv) {
       return 1;
     }
   }
-  return 0;
+  return status;
 }
 
 }  // namespace

@@ -4,11 +4,13 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <thread>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "tonus/host/daemon/config_file.hpp"
 #include "tonus/host/transport/host_clock.hpp"
 #include "tonus/sim/humanoid.hpp"
 
@@ -78,7 +80,59 @@ std::unique_ptr<Daemon> Daemon::create(const DaemonConfig& config, std::string t
 
 Daemon::~Daemon() { stop(); }
 
+bool Daemon::record_to(const std::string& path, std::string& error) {
+  recording::Header h;
+  h.config_toml = to_toml(config_);
+  h.rate_hz = config_.physics.rate_hz;
+  h.nq = model_->nq;
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  h.created_utc = fmt::format("{:04}-{:02}-{:02}T{:02}:{:02}:{:02}Z", utc.tm_year + 1900, utc.tm_mon + 1, utc.tm_mday,
+                              utc.tm_hour, utc.tm_min, utc.tm_sec);
+  h.tonus_version = TONUS_VERSION;
+  recorder_ = Recorder::create(path, h, error);
+  if (!recorder_) return false;
+  record_path_ = path;
+  core_->set_recorder(recorder_.get());
+  output_->set_recorder(recorder_.get());
+  return true;
+}
+
+std::optional<recording::Reader> Daemon::open_recording(const std::string& path, DaemonConfig& config,
+                                                        std::string& error) {
+  std::optional<recording::Reader> r = recording::Reader::open(path, error);
+  if (!r) return std::nullopt;
+  DaemonConfig c;
+  if (const std::string e = parse_config(r->header().config_toml, path + " (its configuration)", c); !e.empty()) {
+    error = e;
+    return std::nullopt;
+  }
+  config = c;
+  return r;
+}
+
+void Daemon::replay_from(recording::Reader reader, double speed) {
+  if (reader.header().nq != model_->nq) {
+    spdlog::warn("replay: the recording's model has {} coordinates, this one {}: it will diverge", reader.header().nq,
+                 model_->nq);
+  }
+  replay_ = std::make_unique<ReplayDriver>(*core_, output_.get(), std::move(reader), speed);
+}
+
 bool Daemon::start(std::string& error) {
+  if (replay_) {
+    if (!output_->open_driven(error)) return false;
+    spdlog::info("replay: {:.0f} Hz, VMC to {}:{}", config_.physics.rate_hz, config_.output.host, config_.output.port);
+    replay_->start();
+    started_wall_s_ = wall_s();
+    cpu_seconds_ = cpu_s();
+    return true;
+  }
+  if (recorder_) {
+    recorder_->start();
+    spdlog::info("recording to {}", record_path_);
+  }
   // The tracker first: a bad clip or a port in use stops everything before any thread runs.
   if (!tracker_->start(error)) return false;
   // The output thread just below the physics thread (when real time is asked for at all).
@@ -131,10 +185,12 @@ void Daemon::stop() {
   if (!physics_) return;
   const bool was_running = started_wall_s_ > 0.0;
   if (control_server_) control_server_->stop();
+  if (replay_) replay_->stop();
   band_->stop();
   tracker_->stop();
   output_->stop();
   physics_->stop();
+  if (recorder_) recorder_->stop();  // after the physics: the last ticks go into the last chunk
   if (was_running) {
     run_seconds_ = wall_s() - started_wall_s_;
     cpu_seconds_ = cpu_s() - cpu_seconds_;
@@ -257,7 +313,7 @@ void Daemon::run_for(double seconds, const std::atomic<bool>& stop_flag, bool de
   double next_trace = 0.0;
   double next_status = config_.log.status_interval_s;
   bool status_asked = false;
-  while (!stop_flag.load() && (seconds <= 0.0 || wall_s() - t0 < seconds)) {
+  while (!stop_flag.load() && (seconds <= 0.0 || wall_s() - t0 < seconds) && !(replay_ && replay_->done())) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
     const double t = wall_s() - t0;
     while (next_gift < schedule.size() && schedule[next_gift].at_s <= t) {
@@ -341,6 +397,7 @@ nlohmann::json Daemon::summary_json() const {
   j["tick_max_us"] = cost.max_us();
   j["tick_mean_us"] = cost.mean_us();
   j["overruns"] = physics_->overruns();
+  j["overruns_from_cost"] = physics_->overruns_from_cost();
   j["skipped_ticks"] = physics_->skipped();
   j["overrun_share"] =
       physics_->ticks() > 0 ? static_cast<double>(physics_->overruns()) / static_cast<double>(physics_->ticks()) : 0.0;
@@ -349,6 +406,20 @@ nlohmann::json Daemon::summary_json() const {
   j["realtime_priority"] = physics_->realtime().priority_set;
   j["memory_locked"] = physics_->realtime().memory_locked;
   j["cpu_share"] = run_seconds_ > 0.0 ? cpu_seconds_ / run_seconds_ : 0.0;
+  // Equal hashes, equal outputs (a replay of a recording matches its run).
+  j["output_hash"] = fmt::format("{:016x}", cs.output_hash);
+  j["vmc_hash"] = fmt::format("{:016x}", o.wire_hash);
+  if (recorder_) {
+    const RecorderStatus r = recorder_->status();
+    j["recording"] = {{"path", record_path_}, {"ticks", r.ticks},           {"chunks", r.chunks},
+                      {"bytes", r.bytes},     {"vmc_frames", r.vmc_frames}, {"error", r.error}};
+  }
+  if (replay_) {
+    const ReplayStatus r = replay_->status();
+    j["ticks"] = cs.ticks;
+    j["replay"] = {{"end", to_string(r.end)},     {"error", r.error},           {"ticks", r.ticks},
+                   {"chunks_verified", r.chunks}, {"vmc_frames", r.vmc_frames}, {"position_s", r.position_s}};
+  }
   j["vmc_bundles_sent"] = o.bundles;
   j["vmc_frames_sent"] = o.frames;
   j["vmc_send_errors"] = o.send_errors;
@@ -423,10 +494,11 @@ std::string Daemon::summary_text() const {
     }
   }
   out += fmt::format(
-      "ticks: {} (p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us), overruns {} ({:.3f} %), cpu {:.1f} % of a core\n",
+      "ticks: {} (p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us), overruns {} ({:.3f} %; {} from a tick's own cost, the "
+      "rest woke late), cpu {:.1f} % of a core\n",
       j["ticks"].get<std::uint64_t>(), j["tick_p50_us"].get<double>(), j["tick_p99_us"].get<double>(),
       j["tick_max_us"].get<double>(), j["overruns"].get<std::uint64_t>(), 100.0 * j["overrun_share"].get<double>(),
-      100.0 * j["cpu_share"].get<double>());
+      j["overruns_from_cost"].get<std::uint64_t>(), 100.0 * j["cpu_share"].get<double>());
   out += fmt::format(
       "band: {} reports, {} lost; device sample to tick p50 {:.2f} ms, p99 {:.2f} ms; report to VMC p50 {:.2f} ms, "
       "p99 {:.2f} ms (output period {:.1f} ms)\n",
@@ -436,6 +508,22 @@ std::string Daemon::summary_text() const {
       j["output_period_us"].get<double>() * 1e-3);
   out += fmt::format("vmc: {} bundles to {}:{}\n", j["vmc_bundles_sent"].get<std::uint64_t>(), config_.output.host,
                      config_.output.port);
+  if (j.contains("recording")) {
+    const nlohmann::json& r = j["recording"];
+    out += fmt::format("recording: {} ({} ticks in {} chunks, {:.1f} MB){}\n", r["path"].get<std::string>(),
+                       r["ticks"].get<std::uint64_t>(), r["chunks"].get<std::uint64_t>(),
+                       static_cast<double>(r["bytes"].get<std::uint64_t>()) * 1e-6,
+                       r["error"].get<std::string>().empty() ? "" : "; " + r["error"].get<std::string>());
+  }
+  if (j.contains("replay")) {
+    const nlohmann::json& r = j["replay"];
+    out += fmt::format("replay: {}, {} ticks, {} chunks verified, {} VMC frames{}\n", r["end"].get<std::string>(),
+                       r["ticks"].get<std::uint64_t>(), r["chunks_verified"].get<std::uint64_t>(),
+                       r["vmc_frames"].get<std::uint64_t>(),
+                       r["error"].get<std::string>().empty() ? "" : "; " + r["error"].get<std::string>());
+  }
+  out += fmt::format("outputs: hash {}, VMC bytes hash {}\n", j["output_hash"].get<std::string>(),
+                     j["vmc_hash"].get<std::string>());
   return out;
 }
 

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 
+#include "tonus/host/daemon/recorder.hpp"
+#include "tonus/host/daemon/recording_format.hpp"
+
 namespace tonus::daemon {
 
 std::string_view to_string(GiftKind k) { return k == GiftKind::ball ? "ball" : "cube"; }
@@ -170,6 +173,15 @@ void PhysicsCore::publish(std::int64_t now_us) {
     v.pos = o.pos;
     v.rot = o.quat;
   }
+  std::uint64_t h = stats_.output_hash;
+  h = recording::hash_bytes(h, s.qpos.data(), sizeof(double) * static_cast<std::size_t>(model_->nq));
+  h = recording::hash_bytes(h, s.stiffness.data(), sizeof s.stiffness);
+  for (int i = 0; i < s.nobjects; ++i) {
+    const ObjectView& v = s.objects[static_cast<std::size_t>(i)];
+    h = recording::hash_bytes(h, v.pos.data(), 3 * sizeof(double));
+    h = recording::hash_bytes(h, v.rot.coeffs().data(), 4 * sizeof(double));
+  }
+  stats_.output_hash = h;
   status_snapshots_.write_slot() = s;
   snapshots_.publish();
   status_snapshots_.publish();
@@ -182,10 +194,14 @@ void PhysicsCore::close_interval(double& latency_p50_us, double& latency_p99_us)
 }
 
 void PhysicsCore::tick(std::int64_t now_us) {
-  // read
+  // read (and record what was read)
+  Recorder* const rec = recorder_ != nullptr && recorder_->active() ? recorder_ : nullptr;
+  std::uint32_t bands = 0, poses = 0, commands = 0;
   BandSample band;
   while (band_.try_dequeue(band)) {
     ++stats_.band_samples;
+    ++bands;
+    if (rec != nullptr) rec->band(band);
     stiffness_.on_report(band.arrival_us, band.levels);
     band_arrival_us_ = std::max(band_arrival_us_, band.arrival_us);
     if (band.sampled_host_us > 0) {
@@ -196,11 +212,17 @@ void PhysicsCore::tick(std::int64_t now_us) {
   PoseSample* pose = nullptr;
   while ((pose = pose_.peek()) != nullptr) {
     ++stats_.pose_samples;
+    ++poses;
+    if (rec != nullptr) rec->pose(*pose);
     pose_buffer_.push(*pose);
     pose_.pop();
   }
   Command cmd;
-  while (commands_.try_dequeue(cmd)) apply(cmd);
+  while (commands_.try_dequeue(cmd)) {
+    ++commands;
+    if (rec != nullptr) rec->command(cmd);
+    apply(cmd);
+  }
 
   const PoseState ps = pose_buffer_.sample(now_us, input_.reference.qpos);
   input_.reference.has_velocity = false;
@@ -243,6 +265,7 @@ void PhysicsCore::tick(std::int64_t now_us) {
 
   // write
   publish(now_us);
+  if (rec != nullptr) rec->tick(now_us, stats_.ticks, stats_.output_hash, bands, poses, commands);
 }
 
 }  // namespace tonus::daemon

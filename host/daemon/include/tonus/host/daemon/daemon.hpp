@@ -9,6 +9,7 @@
 #include <atomic>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,8 @@
 #include "tonus/host/daemon/control_handler.hpp"
 #include "tonus/host/daemon/physics_core.hpp"
 #include "tonus/host/daemon/physics_thread.hpp"
+#include "tonus/host/daemon/recorder.hpp"
+#include "tonus/host/daemon/replay.hpp"
 #include "tonus/host/daemon/tracker_input.hpp"
 #include "tonus/host/daemon/vmc_output.hpp"
 
@@ -50,6 +53,21 @@ class Daemon {
   ~Daemon();
   Daemon(const Daemon&) = delete;
   Daemon& operator=(const Daemon&) = delete;
+
+  // Recording (before start): every input the physics consumes goes to
+  // `path` (docs/recording.md). The config must be one that reads back from
+  // its own TOML to the same values (tonusd passes it through to_toml and
+  // parse_config first), so a replay builds the very same core.
+  bool record_to(const std::string& path, std::string& error);
+
+  // Replay: the configuration a recording was made with (command-line
+  // overrides may go on top, then create()), and the reader past its header.
+  static std::optional<recording::Reader> open_recording(const std::string& path, DaemonConfig& config,
+                                                         std::string& error);
+  // Before start: replay `reader` instead of running the inputs and the
+  // paced physics thread; `speed` x the recorded pace (0: as fast as it goes).
+  void replay_from(recording::Reader reader, double speed);
+  [[nodiscard]] const ReplayDriver* replay() const { return replay_.get(); }
 
   // Starts every thread; false and `error` (nothing left running) when an
   // input or output cannot be opened.
@@ -89,6 +107,9 @@ class Daemon {
   std::unique_ptr<VmcOutput> output_;
   std::unique_ptr<DaemonControl> control_;
   std::unique_ptr<control::ControlServer> control_server_;
+  std::unique_ptr<Recorder> recorder_;
+  std::string record_path_;
+  std::unique_ptr<ReplayDriver> replay_;
   std::atomic<std::uint32_t> next_id_{1};
   double started_wall_s_ = 0.0;
   double run_seconds_ = 0.0;

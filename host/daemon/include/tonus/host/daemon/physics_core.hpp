@@ -25,6 +25,8 @@
 
 namespace tonus::daemon {
 
+class Recorder;
+
 struct PhysicsCoreConfig {
   avatar::AvatarConfig avatar;
   StiffnessInputConfig stiffness;
@@ -47,6 +49,9 @@ struct CoreStats {
   std::uint64_t events_dropped = 0;       // the event queue was full
   std::uint64_t reactions_untracked = 0;  // more gifts at once than reaction slots
   std::uint64_t avatar_resets = 0;
+  // FNV-1a over every tick's output (B's configuration, the objects' poses,
+  // the applied stiffness): equal hashes, equal outputs; a replay checks it.
+  std::uint64_t output_hash = 14695981039346656037ULL;
   Levels stiffness_min{1.0, 1.0, 1.0, 1.0};  // applied, over every tick
   Levels stiffness_max{0.0, 0.0, 0.0, 0.0};
 };
@@ -76,6 +81,10 @@ class PhysicsCore final : public TickTarget {
   bool push_band(const BandSample& s) { return band_.try_enqueue(s) || count_drop(band_dropped_); }
   bool push_pose(const PoseSample& s) { return pose_.try_enqueue(s) || count_drop(pose_dropped_); }
   bool push_command(const Command& c);
+
+  // Every input a tick consumes goes to the recorder too (set before the
+  // physics thread starts; nullptr: not recording).
+  void set_recorder(Recorder* recorder) { recorder_ = recorder; }
 
   // One tick at host time now_us (the tick's deadline).
   void tick(std::int64_t now_us) override;
@@ -149,6 +158,7 @@ class PhysicsCore final : public TickTarget {
   bool band_live_ = false;
   PoseState pose_state_ = PoseState::none;
   CoreStats stats_;
+  Recorder* recorder_ = nullptr;
 };
 
 }  // namespace tonus::daemon
