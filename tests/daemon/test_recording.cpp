@@ -8,9 +8,9 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <bit>
 #include <cmath>
-#include <cstring>
 #include <fstream>
 #include <limits>
 #include <random>
@@ -86,9 +86,12 @@ recording::Chunk random_chunk(std::mt19937_64& rng, int nq, std::uint64_t first_
 }
 
 // Bitwise equality, so NaN payloads and -0.0 count.
-template <class T>
-bool same_bits(const T& a, const T& b) {
-  return std::memcmp(&a, &b, sizeof(T)) == 0;
+template <std::size_t N>
+bool same_bits(const std::array<double, N>& a, const std::array<double, N>& b) {
+  for (std::size_t i = 0; i < N; ++i) {
+    if (std::bit_cast<std::uint64_t>(a[i]) != std::bit_cast<std::uint64_t>(b[i])) return false;
+  }
+  return true;
 }
 
 bool same_band(const BandSample& a, const BandSample& b) {
@@ -262,7 +265,7 @@ TEST_CASE("recording: a core fed a recording's inputs reproduces its outputs, a 
   pose.qpos = model.qpos0;
   const std::int64_t t0 = 5'000'000;
   for (int k = 0; k < 2500; ++k) {
-    const std::int64_t now = t0 + 1000 * k;
+    const std::int64_t now = t0 + std::int64_t{1000} * k;
     BandSample b;
     b.arrival_us = now - 200;
     b.levels.fill(0.5 + 0.4 * std::sin(k * 0.003));

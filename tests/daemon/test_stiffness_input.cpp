@@ -2,6 +2,8 @@
 // 100 ms of going stale, taken over again by the next report.
 #include <doctest/doctest.h>
 
+#include <limits>
+
 #include "tonus/host/daemon/stiffness_input.hpp"
 
 using namespace tonus::daemon;
@@ -37,7 +39,7 @@ TEST_CASE("stiffness: 100 ms without a report eases to the safe default within t
 TEST_CASE("stiffness: non-finite levels keep the last value, bad configs are named") {
   StiffnessInput s(StiffnessInputConfig{});
   s.on_report(0, {0.7, 0.7, 0.7, 0.7});
-  s.on_report(1000, {std::nan(""), 0.2, INFINITY, 0.1});
+  s.on_report(1000, {std::nan(""), 0.2, std::numeric_limits<double>::infinity(), 0.1});
   CHECK(s.at(1000)[0] == 0.7);
   CHECK(s.at(1000)[1] == 0.2);
   CHECK(s.at(1000)[2] == 0.7);

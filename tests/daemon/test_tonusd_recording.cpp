@@ -22,7 +22,7 @@ std::string temp(const std::string& name) { return "/tmp/tonusd-rec-test-" + std
 struct Run {
   int rc = -1;
   std::string log;
-  nlohmann::json summary;
+  nlohmann::json summary = nlohmann::json::object();
 };
 
 Run tonusd(std::vector<std::string> args, const std::string& name) {
@@ -111,7 +111,8 @@ TEST_CASE("tonusd --record: a daemon killed mid-take leaves a file that replays 
   // The first chunk lands about a second into the take: from there, 2.5 s more, then SIGKILL.
   const auto past_header = [](const std::vector<unsigned char>& b) {  // "TONUSREC", version, length, JSON, CRC
     if (b.size() < 16) return false;
-    const std::size_t json = b[12] | (b[13] << 8U) | (b[14] << 16U) | (static_cast<std::size_t>(b[15]) << 24U);
+    std::size_t json = 0;
+    for (std::size_t i = 0; i < 4; ++i) json |= static_cast<std::size_t>(b[12 + i]) << (8U * i);
     return b.size() > 16 + json + 4;
   };
   bool first_chunk = false;

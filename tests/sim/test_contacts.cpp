@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "sim_fixtures.hpp"
 #include "tonus/sim/objects.hpp"
@@ -255,7 +256,7 @@ TEST_CASE("objects: add, remove, stale handles, capacity, bad specs") {
   bad.quat = Quat(0, 0, 0, 0);
   CHECK(add_object(*data, bad).error == ObjectError::bad_pose);
   bad = s;
-  bad.lin_vel.y() = INFINITY;
+  bad.lin_vel.y() = std::numeric_limits<double>::infinity();
   CHECK(add_object(*data, bad).error == ObjectError::bad_velocity);
   bad = s;
   bad.material.restitution = 2.0;
