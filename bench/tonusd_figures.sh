@@ -18,7 +18,7 @@ trap 'rm -rf "$out"; [ -n "${hog:-}" ] && kill "$hog" 2>/dev/null || true' EXIT
 run() {  # name, then the command's prefix
   local name=$1
   shift
-  "$@" "$bin/tonusd" --demo --seconds "$seconds" --no-control --json "$out/$name.json" >"$out/$name.log" 2>&1 || {
+  "$@" "$bin/tonusd" --demo --seconds "$seconds" --no-control --viewer-port 0 --json "$out/$name.json" >"$out/$name.log" 2>&1 || {
     cat "$out/$name.log" >&2
     exit 1
   }

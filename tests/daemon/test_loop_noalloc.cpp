@@ -22,6 +22,7 @@ TEST_CASE("the physics loop allocates nothing: 2 s at 1 kHz with band, tracker, 
   REQUIRE(test::probe_allocation_counter() == 2);
   std::string error;
   PhysicsCoreConfig cfg;
+  cfg.viewer_every_ticks = 10;  // the viewer's snapshots too
   auto core = PhysicsCore::create(test::daemon_humanoid(), cfg, error);
   REQUIRE(core);
   PacingConfig pace;

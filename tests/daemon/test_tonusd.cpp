@@ -36,7 +36,7 @@ nlohmann::json run_tonusd(const std::vector<std::string>& args, const std::strin
   std::vector<std::string> a = args;
   // Without SCHED_FIFO: the tests check behaviour, and real-time threads of a sanitizer build would
   // starve the simulator and the test itself on a 2-core machine running the suite in parallel.
-  a.insert(a.end(), {"--json", json, "--no-control", "--no-realtime"});
+  a.insert(a.end(), {"--json", json, "--no-control", "--no-viewer", "--no-realtime"});
   Process p(TONUSD, a, temp_path(name + ".log"));
   REQUIRE(p.started());
   const int rc = p.wait(std::chrono::seconds(60));
@@ -171,10 +171,11 @@ TEST_CASE("tonusd: the band killed mid-stream relaxes the stiffness to the safe 
   for (int i = 0; i < 200 && ::access(sock.c_str(), F_OK) != 0; ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   const std::string json = temp_path("kill.json");
-  Process d(TONUSD,
-            {"--no-realtime", "--seconds", "8", "--band", "socket", "--band-socket", sock, "--tracker", "none",
-             "--vmc-port", std::to_string(capture.port()), "--vmc-rate", "200", "--no-control", "--json", json},
-            temp_path("kill.log"));
+  Process d(
+      TONUSD,
+      {"--no-realtime", "--seconds", "8", "--band", "socket", "--band-socket", sock, "--tracker", "none", "--vmc-port",
+       std::to_string(capture.port()), "--vmc-rate", "200", "--no-control", "--no-viewer", "--json", json},
+      temp_path("kill.log"));
   REQUIRE(d.started());
   std::this_thread::sleep_for(std::chrono::milliseconds(2500));
   const std::int64_t kill_us = test::steady_us();
@@ -220,7 +221,7 @@ TEST_CASE("tonusd: a VMC performer's stream is followed, held when it stops, eas
   Process d(TONUSD,
             {"--no-realtime", "--seconds", "5", "--band", "none", "--tracker", "vmc", "--vmc-mode", "performer",
              "--listen-port", "0", "--vmc-port", std::to_string(capture.port()), "--vmc-rate", "100", "--no-control",
-             "--json", json},
+             "--no-viewer", "--json", json},
             temp_path("performer.log"));
   REQUIRE(d.started());
   const int listen_port = port_in_log(d, "mode on 127\\.0\\.0\\.1:([0-9]+)");
@@ -303,8 +304,8 @@ TEST_CASE("tonusd: a VMC performer's stream is followed, held when it stops, eas
 TEST_CASE("tonusd: the control API spawns gifts, overrides and releases the stiffness, reports status, tonus ctl too") {
   VmcCapture capture;
   Process d(TONUSD,
-            {"--no-realtime", "--seconds", "10", "--tracker", "none", "--control-port", "0", "--vmc-port",
-             std::to_string(capture.port()), "--vmc-rate", "200"},
+            {"--no-realtime", "--no-viewer", "--seconds", "10", "--tracker", "none", "--control-port", "0",
+             "--vmc-port", std::to_string(capture.port()), "--vmc-rate", "200"},
             temp_path("control.log"));
   REQUIRE(d.started());
   const int port = port_in_log(d, "control: http://127\\.0\\.0\\.1:([0-9]+)/status");
@@ -371,7 +372,7 @@ TEST_CASE("tonusd: a bad config names the key and the value, and nothing starts"
   int k = 0;
   for (const auto& c : cases) {
     const std::string cfg = write_file("bad" + std::to_string(k) + ".toml", c.toml);
-    Process p(TONUSD, {"--no-realtime", "--config", cfg, "--seconds", "5"},
+    Process p(TONUSD, {"--no-realtime", "--no-viewer", "--config", cfg, "--seconds", "5"},
               temp_path("bad" + std::to_string(k++) + ".log"));
     const int rc = p.wait(std::chrono::seconds(10));
     INFO(p.output());
@@ -383,7 +384,7 @@ TEST_CASE("tonusd: a bad config names the key and the value, and nothing starts"
   VmcCapture busy;  // holds a UDP port on 127.0.0.1
   Process p(TONUSD,
             {"--no-realtime", "--tracker", "vmc", "--listen-port", std::to_string(busy.port()), "--seconds", "5",
-             "--no-control"},
+             "--no-control", "--no-viewer"},
             temp_path("busy.log"));
   const int rc = p.wait(std::chrono::seconds(10));
   INFO(p.output());
@@ -415,7 +416,8 @@ TEST_CASE("tonusd: VMC trackers (a headset and two controllers) calibrate from a
   VmcCapture capture;
   Process d(TONUSD,
             {"--no-realtime", "--seconds", "5", "--band", "none", "--tracker", "vmc", "--vmc-mode", "trackers",
-             "--listen-port", "0", "--vmc-port", std::to_string(capture.port()), "--vmc-rate", "100", "--no-control"},
+             "--listen-port", "0", "--vmc-port", std::to_string(capture.port()), "--vmc-rate", "100", "--no-control",
+             "--no-viewer"},
             temp_path("trackers.log"));
   REQUIRE(d.started());
   const int listen_port = port_in_log(d, "mode on 127\\.0\\.0\\.1:([0-9]+)");

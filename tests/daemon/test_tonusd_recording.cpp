@@ -28,7 +28,7 @@ struct Run {
 Run tonusd(std::vector<std::string> args, const std::string& name) {
   const std::string json = temp(name + ".json");
   ::unlink(json.c_str());
-  args.insert(args.end(), {"--json", json, "--no-control", "--no-realtime"});
+  args.insert(args.end(), {"--json", json, "--no-control", "--no-viewer", "--no-realtime"});
   Process p(TONUSD, args, temp(name + ".log"));
   REQUIRE(p.started());
   Run r;
@@ -105,7 +105,9 @@ TEST_CASE("tonusd --replay: the recorded run's VMC bytes again, datagram for dat
 
 TEST_CASE("tonusd --record: a daemon killed mid-take leaves a file that replays all but its last second") {
   const std::string path = temp("killed.tonusrec");
-  Process p(TONUSD, {"--demo", "--seconds", "30", "--record", path, "--no-control", "--no-realtime", "--vmc-port", "9"},
+  Process p(TONUSD,
+            {"--demo", "--seconds", "30", "--record", path, "--no-control", "--no-viewer", "--no-realtime",
+             "--vmc-port", "9"},
             temp("killed.log"));
   REQUIRE(p.started());
   // The first chunk lands about a second into the take: from there, 2.5 s more, then SIGKILL.

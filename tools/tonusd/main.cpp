@@ -53,6 +53,11 @@ int run(int argc, char** argv) {
   app.add_option("--replay", replay_path, "replay a recording: the same outputs, bit for bit, then exit");
   app.add_option("--speed", speed, "--replay's pace: x the recorded speed (0: as fast as it goes)")
       ->check(CLI::Range(0.0, 1000.0));
+  bool hold = false, no_viewer = false;
+  int viewer_port = -1;
+  app.add_flag("--hold", hold, "--replay: stay at the end, paused, for the viewer to seek back (until Ctrl-C)");
+  app.add_option("--viewer-port", viewer_port, "viewer.port: the live web viewer (0: any free port)");
+  app.add_flag("--no-viewer", no_viewer, "viewer.enabled = false");
   app.add_option("--band", band_source, "band.source: sim, socket, hid, can, candump, none");
   app.add_option("--band-socket", band_socket, "band.sim_socket: a tonus-band-sim serving --hid-socket PATH");
   app.add_option("--band-candump", candump_path, "band.candump_path: a candump log to replay");
@@ -92,6 +97,11 @@ int run(int argc, char** argv) {
       std::cerr << "tonusd: replay: " << error << "\n";
       return 2;
     }
+    // What only looks at the run (the viewer, the control API, the logs) is this run's, not the recording's.
+    const DaemonConfig defaults;
+    cfg.viewer = defaults.viewer;
+    cfg.control = defaults.control;
+    cfg.log = defaults.log;
   }
   if (!config_path.empty()) {
     if (const std::string e = load_config(config_path, cfg); !e.empty()) {
@@ -112,6 +122,8 @@ int run(int argc, char** argv) {
   if (rate_hz >= 0.0) cfg.physics.rate_hz = rate_hz;
   if (control_port >= 0) cfg.control.port = control_port;
   if (no_control) cfg.control.enabled = false;
+  if (viewer_port >= 0) cfg.viewer.port = viewer_port;
+  if (no_viewer) cfg.viewer.enabled = false;
   if (no_realtime) {
     cfg.physics.realtime_priority = 0;
     cfg.physics.lock_memory = false;
@@ -179,7 +191,10 @@ int run(int argc, char** argv) {
     std::cerr << "tonusd: " << error << "\n";
     return 1;
   }
-  if (replay) d->replay_from(std::move(*replay), speed);
+  if (replay) {
+    d->replay_from(std::move(*replay), speed);
+    d->hold_replay_at_end(hold);
+  }
   if (!d->start(error)) {
     std::cerr << "tonusd: " << error << "\n";
     return 1;

@@ -105,7 +105,9 @@ std::future<std::string> BandInput::calibrate(const std::string& command, double
 
 BandStatus BandInput::status() const {
   const std::lock_guard<std::mutex> lock(mutex_);
-  return status_;
+  BandStatus s = status_;
+  s.calibrated = calibrated_.load(std::memory_order_relaxed);
+  return s;
 }
 
 host::ReconnectingBandLink::Opener BandInput::make_opener() {
@@ -185,6 +187,7 @@ void BandInput::on_stream(const host::LinkEvent& ev) {
   BandSample s;
   s.arrival_us = ev.rx_host_us;
   s.sequence = ev.stream.sequence;
+  calibrated_.store((ev.stream.status & proto::status_bit::calibrated) != 0, std::memory_order_relaxed);
   s.levels.fill(std::nan(""));  // groups the band does not have keep their last (or the safe default)
   const std::size_t n = std::min<std::size_t>(ev.stream.group_count, s.levels.size());
   for (std::size_t g = 0; g < n; ++g) s.levels[g] = static_cast<double>(ev.stream.levels[g]) / proto::kLevelMax;

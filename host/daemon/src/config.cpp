@@ -83,6 +83,9 @@ std::string validate(const DaemonConfig& c) {
   }
   if (std::string e = validate_port("control.port", c.control.port, true); !e.empty()) return e;
   if (c.control.address.empty()) return "control.address = \"\": an address is needed";
+  if (std::string e = validate_port("viewer.port", c.viewer.port, true); !e.empty()) return e;
+  if (c.viewer.address.empty()) return "viewer.address = \"\": an address is needed";
+  if (!in(c.viewer.rate_hz, 1.0, 120.0)) return bad("viewer.rate_hz", c.viewer.rate_hz, "must be 1..120");
   static constexpr std::array<std::string_view, 7> kLevels{"trace", "debug",    "info", "warn",
                                                            "error", "critical", "off"};
   if (std::find(kLevels.begin(), kLevels.end(), c.log.level) == kLevels.end()) {

@@ -162,11 +162,12 @@ constexpr std::array kFeedforwards{FeedforwardChoice::simulation, FeedforwardCho
                                    FeedforwardChoice::none};
 
 std::string read_all(const toml::table& root, DaemonConfig& c) {
-  static constexpr std::array<std::string_view, 7> kTables{"band",    "tracker", "physics", "output",
-                                                           "control", "log",     "demo"};
+  static constexpr std::array<std::string_view, 8> kTables{"band",    "tracker", "physics", "output",
+                                                           "control", "viewer",  "log",     "demo"};
   for (const auto& [k, v] : root) {
     if (std::find(kTables.begin(), kTables.end(), k.str()) == kTables.end()) {
-      return fmt::format("{}: unknown table (known: band, tracker, physics, output, control, log, demo)", k.str());
+      return fmt::format("{}: unknown table (known: band, tracker, physics, output, control, viewer, log, demo)",
+                         k.str());
     }
     if (!v.is_table()) return fmt::format("{}: must be a table", k.str());
   }
@@ -262,6 +263,18 @@ std::string read_all(const toml::table& root, DaemonConfig& c) {
     if (!r.error_.empty()) return r.error_;
   }
   {
+    ViewerConfig& k = c.viewer;
+    TableReader r(root["viewer"].as_table(), "viewer.");
+    r.get("enabled", k.enabled);
+    r.get("address", k.address);
+    r.get("port", k.port);
+    r.get("allow_remote", k.allow_remote);
+    r.get("rate_hz", k.rate_hz);
+    r.get("web_root", k.web_root);
+    r.finish();
+    if (!r.error_.empty()) return r.error_;
+  }
+  {
     TableReader r(root["log"].as_table(), "log.");
     r.get("level", c.log.level);
     r.get("status_interval_s", c.log.status_interval_s);
@@ -350,6 +363,10 @@ std::string to_toml(const DaemonConfig& c) {
   out += "\n[control]\n";
   out += fmt::format("enabled = {}\naddress = {}\nport = {}\nallow_remote = {}\n", c.control.enabled,
                      q(c.control.address), c.control.port, c.control.allow_remote);
+  out += "\n[viewer]\n";
+  out += fmt::format("enabled = {}\naddress = {}\nport = {}\nallow_remote = {}\nrate_hz = {}\nweb_root = {}\n",
+                     c.viewer.enabled, q(c.viewer.address), c.viewer.port, c.viewer.allow_remote, c.viewer.rate_hz,
+                     q(c.viewer.web_root));
   out += "\n[log]\n";
   out += fmt::format("level = {}\nstatus_interval_s = {}\n", q(c.log.level), c.log.status_interval_s);
   out += "\n[demo]\n";

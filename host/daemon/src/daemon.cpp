@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <ctime>
 #include <thread>
 
@@ -12,6 +13,7 @@
 
 #include "tonus/host/daemon/config_file.hpp"
 #include "tonus/host/transport/host_clock.hpp"
+#include "tonus/host/viewer/server.hpp"
 #include "tonus/sim/humanoid.hpp"
 
 namespace tonus::daemon {
@@ -64,6 +66,10 @@ std::unique_ptr<Daemon> Daemon::create(const DaemonConfig& config, std::string t
   pc.stiffness = config.band.stiffness;
   pc.avatar.stiffness.initial = config.band.stiffness.safe_default[0];
   pc.pose = config.tracker.buffer;
+  if (config.viewer.enabled) {  // snapshots for the viewer at twice its frame rate
+    pc.viewer_every_ticks =
+        std::max(1, static_cast<int>(std::lround(config.physics.rate_hz / (2.0 * config.viewer.rate_hz))));
+  }
   d->core_ = PhysicsCore::create(*d->model_, pc, error);
   if (!d->core_) return nullptr;
   PacingConfig pace;
@@ -120,10 +126,62 @@ void Daemon::replay_from(recording::Reader reader, double speed) {
   replay_ = std::make_unique<ReplayDriver>(*core_, output_.get(), std::move(reader), speed);
 }
 
+bool Daemon::start_viewer(std::string& error) {
+  if (!config_.viewer.enabled) return true;
+  viewer_ = std::make_unique<ViewerFeed>(config_.viewer, *model_, *core_, replay_ ? "replay" : "live");
+  ViewerFeed::Playback playback = [this](const viewer::PlaybackMessage& m) -> std::string {
+    if (!replay_) return "not playing a recording (tonusd --replay FILE)";
+    switch (m.action) {
+      case viewer::PlaybackAction::play: replay_->resume(); break;
+      case viewer::PlaybackAction::pause: replay_->pause(); break;
+      case viewer::PlaybackAction::seek: replay_->seek(m.position_s); break;
+    }
+    return {};
+  };
+  if (!viewer_->start(
+          error, control_.get(), replay_ != nullptr, [this](viewer::Frame& f) { viewer_extras(f); }, playback)) {
+    viewer_.reset();
+    return false;
+  }
+  // An interface: scripts and tests read this line.
+  std::fputs(fmt::format("viewer: {}\n", viewer_->url()).c_str(), stdout);
+  std::fflush(stdout);
+  return true;
+}
+
+void Daemon::viewer_extras(viewer::Frame& f) {
+  const BandStatus b = band_->status();
+  IntervalFigures interval;
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    interval = last_interval_;
+  }
+  f.band.source = replay_ ? "replay" : std::string(to_string(config_.band.source));
+  f.band.connected = b.connected;
+  f.band.calibrated = b.calibrated;
+  f.band.latency_p50_ms = interval.band_latency_p50_us * 1e-3;
+  f.band.latency_p99_ms = interval.band_latency_p99_us * 1e-3;
+  f.band.reports = b.link.delivered;
+  f.band.lost = b.link.lost;
+  f.metrics.ticks = replay_ ? f.tick : physics_->ticks();
+  f.metrics.overruns = physics_->overruns();
+  f.metrics.tick_p50_us = interval.p50_us;
+  f.metrics.tick_p99_us = interval.p99_us;
+  f.metrics.tick_max_us = interval.max_us;
+  f.metrics.tracker_rate_hz = replay_ ? 0.0 : tracker_->status().rate_hz;
+  if (replay_) {
+    const ReplayStatus r = replay_->status();
+    f.playback = viewer::PlaybackFrame{replay_->duration_s(), r.position_s, !replay_->paused()};
+  }
+}
+
 bool Daemon::start(std::string& error) {
+  // The control API's handler serves the HTTP server and the viewer's page alike.
+  control_ = std::make_unique<DaemonControl>(*this);
   if (replay_) {
     if (!output_->open_driven(error)) return false;
     spdlog::info("replay: {:.0f} Hz, VMC to {}:{}", config_.physics.rate_hz, config_.output.host, config_.output.port);
+    if (!start_viewer(error)) return false;
     replay_->start();
     started_wall_s_ = wall_s();
     cpu_seconds_ = cpu_s();
@@ -160,7 +218,6 @@ bool Daemon::start(std::string& error) {
                to_string(config_.physics.feedforward), config_.output.host, config_.output.port,
                config_.output.rate_hz);
   if (config_.control.enabled) {
-    control_ = std::make_unique<DaemonControl>(*this);
     control_server_ = std::make_unique<control::ControlServer>(*control_);
     const std::string e =
         control_server_->start(config_.control.address, config_.control.port, config_.control.allow_remote);
@@ -175,6 +232,13 @@ bool Daemon::start(std::string& error) {
     }
     spdlog::info("control: http://{}:{}/status (tonus ctl)", config_.control.address, control_server_->port());
   }
+  if (!start_viewer(error)) {
+    if (control_server_) control_server_->stop();
+    physics_->stop();
+    output_->stop();
+    tracker_->stop();
+    return false;
+  }
   band_->start();
   started_wall_s_ = wall_s();
   cpu_seconds_ = cpu_s();
@@ -184,6 +248,7 @@ bool Daemon::start(std::string& error) {
 void Daemon::stop() {
   if (!physics_) return;
   const bool was_running = started_wall_s_ > 0.0;
+  if (viewer_) viewer_->stop();
   if (control_server_) control_server_->stop();
   if (replay_) replay_->stop();
   band_->stop();
@@ -288,6 +353,10 @@ void Daemon::drain_events() {
 void Daemon::log_status() {
   IntervalFigures f;
   if (!physics_->take_interval(f)) return;
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    last_interval_ = f;
+  }
   const BandStatus b = band_->status();
   const TrackerStatus t = tracker_->status();
   const OutputStatus o = output_->status();

@@ -27,12 +27,47 @@ PhysicsCore::PhysicsCore(const sim::Model& model, const PhysicsCoreConfig& confi
       controller_(std::make_unique<avatar::AvatarController>(std::move(controller))),
       stiffness_(config.stiffness),
       pose_buffer_(model, config.pose) {
+  start_standing();
+}
+
+void PhysicsCore::start_standing() {
   // Start where the pose buffer starts (neutral, standing), at the safe stiffness.
   Qpos start{};
   pose_buffer_.sample(0, start);
   input_.reference.qpos = start;
   controller_->resync(input_.reference);
-  controller_->set_stiffness_now(config.stiffness.safe_default);
+  controller_->set_stiffness_now(config_.stiffness.safe_default);
+}
+
+bool PhysicsCore::restart(std::string& error) {
+  avatar::AvatarController::Created c = avatar::AvatarController::create(*model_, config_.avatar);
+  if (!c) {
+    error = c.error;
+    return false;
+  }
+  controller_ = std::make_unique<avatar::AvatarController>(std::move(*c.controller));
+  stiffness_ = StiffnessInput(config_.stiffness);
+  pose_buffer_ = PoseBuffer(*model_, config_.pose);
+  BandSample b;
+  while (band_.try_dequeue(b)) {
+  }
+  PoseSample p;
+  while (pose_.try_dequeue(p)) {
+  }
+  Command cmd;
+  while (commands_.try_dequeue(cmd)) {
+  }
+  override_.reset();
+  input_ = avatar::TickInput{};
+  reactions_ = {};
+  object_ids_ = {};
+  object_kinds_ = {};
+  band_arrival_us_ = 0;
+  band_live_ = false;
+  pose_state_ = PoseState::none;
+  stats_ = CoreStats{};
+  start_standing();
+  return true;
 }
 
 bool PhysicsCore::push_command(const Command& c) {
@@ -185,6 +220,39 @@ void PhysicsCore::publish(std::int64_t now_us) {
   status_snapshots_.write_slot() = s;
   snapshots_.publish();
   status_snapshots_.publish();
+  if (config_.viewer_every_ticks > 0 && stats_.ticks % static_cast<std::uint64_t>(config_.viewer_every_ticks) == 0) {
+    publish_viewer(s);
+  }
+}
+
+void PhysicsCore::publish_viewer(const Snapshot& s) {
+  ViewerSnapshot& v = viewer_snapshots_.write_slot();
+  v.base = s;
+  v.reference = controller_->sim_a().qpos;
+  const sim::Data& b = controller_->sim_b();
+  v.contacts_total = b.ncon;
+  // The strongest first when there are more than the viewer takes (no allocation: indices on the stack).
+  std::array<int, sim::kMaxContacts> order{};
+  const auto n = static_cast<std::size_t>(std::clamp(b.ncon, 0, static_cast<int>(sim::kMaxContacts)));
+  for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<int>(i);
+  const std::size_t keep = std::min(n, kViewerContacts);
+  std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(keep),
+                    order.begin() + static_cast<std::ptrdiff_t>(n), [&b](int x, int y) {
+                      return b.contacts[static_cast<std::size_t>(x)].force_world.squaredNorm() >
+                             b.contacts[static_cast<std::size_t>(y)].force_world.squaredNorm();
+                    });
+  using Kind = sim::ContactSide::Kind;
+  for (std::size_t i = 0; i < keep; ++i) {
+    const sim::Contact& c = b.contacts[static_cast<std::size_t>(order[i])];
+    ContactView& cv = v.contacts[i];
+    cv.pos = c.pos;
+    // force_world acts on side a: the arrow shows the force on the avatar or the object, not on the ground.
+    cv.force_n = c.a.kind == Kind::ground ? sim::Vec3(-c.force_world) : c.force_world;
+    cv.avatar_on_ground =
+        (c.a.kind == Kind::ground && c.b.kind == Kind::body) || (c.b.kind == Kind::ground && c.a.kind == Kind::body);
+  }
+  v.ncontacts = static_cast<int>(keep);
+  viewer_snapshots_.publish();
 }
 
 void PhysicsCore::close_interval(double& latency_p50_us, double& latency_p99_us) {

@@ -370,7 +370,41 @@ std::optional<Reader> Reader::open(const std::string& path, std::string& error) 
     return std::nullopt;
   }
   r.offset_ = 16 + json.size();
+  r.first_chunk_offset_ = r.offset_;
   return r;
+}
+
+bool Reader::rewind() {
+  if (std::fseek(file_, static_cast<long>(first_chunk_offset_), SEEK_SET) != 0) return false;
+  offset_ = first_chunk_offset_;
+  chunks_ = 0;
+  error_.clear();
+  return true;
+}
+
+double Reader::duration_s() {
+  const long here = std::ftell(file_);
+  std::int64_t first_us = 0, last_us = 0;
+  std::uint64_t last_ticks = 0;
+  bool any = false;
+  if (std::fseek(file_, static_cast<long>(first_chunk_offset_), SEEK_SET) == 0) {
+    for (;;) {
+      std::uint8_t head[12 + 24];  // marker, length, CRC; first tick, tick count, first time
+      if (std::fread(head, 1, sizeof head, file_) != sizeof head || std::memcmp(head, kChunkMagic, 4) != 0) break;
+      In in({head + 4, sizeof head - 4});
+      const std::uint32_t length = in.u32();
+      (void)in.u32();
+      (void)in.u64();
+      last_ticks = in.u32();
+      last_us = in.i64();
+      if (!any) first_us = last_us;
+      any = true;
+      if (length < 24 || std::fseek(file_, static_cast<long>(length) - 24, SEEK_CUR) != 0) break;
+    }
+  }
+  std::fseek(file_, here, SEEK_SET);
+  if (!any) return 0.0;
+  return static_cast<double>(last_us - first_us) * 1e-6 + static_cast<double>(last_ticks) / header_.rate_hz;
 }
 
 Reader::Reader(Reader&& other) noexcept
@@ -379,6 +413,7 @@ Reader::Reader(Reader&& other) noexcept
       error_(std::move(other.error_)),
       chunks_(other.chunks_),
       offset_(other.offset_),
+      first_chunk_offset_(other.first_chunk_offset_),
       buffer_(std::move(other.buffer_)) {}
 
 Reader& Reader::operator=(Reader&& other) noexcept {
@@ -389,6 +424,7 @@ Reader& Reader::operator=(Reader&& other) noexcept {
     error_ = std::move(other.error_);
     chunks_ = other.chunks_;
     offset_ = other.offset_;
+    first_chunk_offset_ = other.first_chunk_offset_;
     buffer_ = std::move(other.buffer_);
   }
   return *this;

@@ -93,7 +93,7 @@ class Handler {
  public:
   virtual ~Handler() = default;
 
-  // POST /gifts: throw a ball or drop a cube (e.g. 201 with the gift's id).
+  // POST /gifts: throw a ball or drop a cube (tonusd: 202 with the gift's id, queued for the next tick).
   virtual Reply spawn_gift(const GiftRequest& request) = 0;
   // DELETE /gifts: remove every gift.
   virtual Reply clear_gifts() = 0;

@@ -26,8 +26,9 @@ namespace tonus::daemon {
 // it is not the real-time thread).
 struct BandStatus {
   bool connected = false;
-  std::string device;    // identity line of the last device met
-  host::LinkStats link;  // reports delivered, lost, late, duplicates, restarts, disconnects, ...
+  bool calibrated = false;  // the newest report says the band holds a calibration
+  std::string device;       // identity line of the last device met
+  host::LinkStats link;     // reports delivered, lost, late, duplicates, restarts, disconnects, ...
   bool clock_synced = false;
   double clock_offset_us = 0.0;
   double clock_drift_ppm = 0.0;
@@ -73,6 +74,7 @@ class BandInput {
   std::unique_ptr<host::ClockSync> sync_;
   std::uint8_t token_ = 1;
   mutable std::mutex mutex_;  // guards status_ and pending_
+  std::atomic<bool> calibrated_{false};
   BandStatus status_;
   std::vector<std::unique_ptr<Pending>> pending_;
   struct SimChild;

@@ -81,6 +81,17 @@ struct ControlConfig {
   bool allow_remote = false;  // must be true for any address beyond loopback
 };
 
+// The live web viewer (host/viewer, docs/viewer.md): the page and its
+// WebSocket on one port.
+struct ViewerConfig {
+  bool enabled = true;
+  std::string address = "127.0.0.1";
+  int port = 39546;
+  bool allow_remote = false;  // must be true for any address beyond loopback
+  double rate_hz = 50.0;      // frames a second to the page (30..60 is plenty)
+  std::string web_root;       // empty: the page in the source tree (host/viewer/web)
+};
+
 struct LogConfig {
   std::string level = "info";  // trace, debug, info, warn, error, off
   double status_interval_s = 5.0;
@@ -104,6 +115,7 @@ struct DaemonConfig {
   PhysicsConfig physics;
   OutputConfig output;
   ControlConfig control;
+  ViewerConfig viewer;
   LogConfig log;
   DemoConfig demo;
 };

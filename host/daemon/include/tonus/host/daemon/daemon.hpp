@@ -24,6 +24,7 @@
 #include "tonus/host/daemon/recorder.hpp"
 #include "tonus/host/daemon/replay.hpp"
 #include "tonus/host/daemon/tracker_input.hpp"
+#include "tonus/host/daemon/viewer_feed.hpp"
 #include "tonus/host/daemon/vmc_output.hpp"
 
 namespace tonus::daemon {
@@ -68,6 +69,9 @@ class Daemon {
   // paced physics thread; `speed` x the recorded pace (0: as fast as it goes).
   void replay_from(recording::Reader reader, double speed);
   [[nodiscard]] const ReplayDriver* replay() const { return replay_.get(); }
+  void hold_replay_at_end(bool hold) {
+    if (replay_) replay_->hold_at_end(hold);
+  }
 
   // Starts every thread; false and `error` (nothing left running) when an
   // input or output cannot be opened.
@@ -91,12 +95,15 @@ class Daemon {
 
   [[nodiscard]] int vmc_listen_port() const { return tracker_ ? tracker_->vmc_port() : 0; }
   [[nodiscard]] int control_port() const { return control_server_ ? control_server_->port() : 0; }
+  [[nodiscard]] int viewer_port() const { return viewer_ ? viewer_->port() : 0; }
   [[nodiscard]] const DaemonConfig& config() const { return config_; }
 
  private:
   Daemon() = default;
   void drain_events();
   void log_status();
+  bool start_viewer(std::string& error);
+  void viewer_extras(viewer::Frame& frame);
 
   DaemonConfig config_;
   std::unique_ptr<sim::Model> model_;
@@ -110,6 +117,8 @@ class Daemon {
   std::unique_ptr<Recorder> recorder_;
   std::string record_path_;
   std::unique_ptr<ReplayDriver> replay_;
+  std::unique_ptr<ViewerFeed> viewer_;
+  IntervalFigures last_interval_;  // guarded by mutex_
   std::atomic<std::uint32_t> next_id_{1};
   double started_wall_s_ = 0.0;
   double run_seconds_ = 0.0;

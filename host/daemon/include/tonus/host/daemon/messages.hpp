@@ -92,4 +92,23 @@ struct Snapshot {
   int nobjects = 0;
 };
 
+// A contact as the viewer draws it: where, and the force on the avatar or
+// object side (N, world, averaged over the step).
+struct ContactView {
+  sim::Vec3 pos = sim::Vec3::Zero();
+  sim::Vec3 force_n = sim::Vec3::Zero();
+  bool avatar_on_ground = false;  // an avatar body against the ground (the ZMP's and the support's contacts)
+};
+inline constexpr std::size_t kViewerContacts = 48;
+
+// Physics -> viewer (triple buffer, every few ticks): the snapshot plus what
+// only the viewer draws.
+struct ViewerSnapshot {
+  Snapshot base;
+  Qpos reference{};                                     // simulation A's configuration: the reference as tracked
+  std::array<ContactView, kViewerContacts> contacts{};  // the strongest, when B has more
+  int ncontacts = 0;
+  int contacts_total = 0;  // B's contacts this step
+};
+
 }  // namespace tonus::daemon

@@ -32,6 +32,7 @@ struct PhysicsCoreConfig {
   StiffnessInputConfig stiffness;
   PoseBufferConfig pose;
   double reaction_window_s = 2.0;  // a gift's reaction is measured over this long after it appears
+  int viewer_every_ticks = 0;      // publish a ViewerSnapshot every this many ticks (0: never)
 };
 
 // Queue capacities (fixed; a full queue drops the newest item and counts it).
@@ -86,6 +87,12 @@ class PhysicsCore final : public TickTarget {
   // physics thread starts; nullptr: not recording).
   void set_recorder(Recorder* recorder) { recorder_ = recorder; }
 
+  // Back to the state create() left (the controller rebuilt, the queues
+  // emptied, the statistics and the output hash reset), for a replay that
+  // seeks backwards. Allocates: never on the paced thread. false and `error`
+  // if the controller cannot be rebuilt (it was built once from the same config).
+  bool restart(std::string& error);
+
   // One tick at host time now_us (the tick's deadline).
   void tick(std::int64_t now_us) override;
   void close_interval(double& latency_p50_us, double& latency_p99_us) override;
@@ -95,6 +102,7 @@ class PhysicsCore final : public TickTarget {
   TripleBuffer<Snapshot>& snapshots() { return snapshots_; }
   TripleBuffer<Snapshot>& status_snapshots() { return status_snapshots_; }
   moodycamel::ReaderWriterQueue<Event>& events() { return events_; }
+  TripleBuffer<ViewerSnapshot>& viewer_snapshots() { return viewer_snapshots_; }
 
   [[nodiscard]] const CoreStats& stats() const { return stats_; }
   [[nodiscard]] std::uint64_t band_dropped() const { return band_dropped_.load(); }
@@ -119,6 +127,7 @@ class PhysicsCore final : public TickTarget {
   };
 
   PhysicsCore(const sim::Model& model, const PhysicsCoreConfig& config, avatar::AvatarController controller);
+  void start_standing();  // the constructor's and restart()'s first pose and stiffness
   static bool count_drop(std::atomic<std::uint64_t>& n) {
     n.fetch_add(1, std::memory_order_relaxed);
     return false;
@@ -133,6 +142,7 @@ class PhysicsCore final : public TickTarget {
   [[nodiscard]] double group_stiffness(sim::Bone b) const;
   [[nodiscard]] double group_hz(sim::Bone b) const;
   void publish(std::int64_t now_us);
+  void publish_viewer(const Snapshot& s);
 
   const sim::Model* model_;
   PhysicsCoreConfig config_;
@@ -146,6 +156,7 @@ class PhysicsCore final : public TickTarget {
   moodycamel::ReaderWriterQueue<Event> events_{kEventQueue};
   TripleBuffer<Snapshot> snapshots_;
   TripleBuffer<Snapshot> status_snapshots_;
+  TripleBuffer<ViewerSnapshot> viewer_snapshots_;
   std::atomic<std::uint64_t> band_dropped_{0}, pose_dropped_{0}, command_dropped_{0};
   std::optional<Levels> override_;
   avatar::TickInput input_;

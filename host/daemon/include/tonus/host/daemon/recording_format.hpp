@@ -84,6 +84,10 @@ class Reader {
   // whole); `corrupt` with error() saying where.
   Status next(Chunk& out);
   [[nodiscard]] const std::string& error() const { return error_; }
+  // Back to the first chunk; false if the file cannot be repositioned.
+  bool rewind();
+  // The recording's length, s (from the chunks' heads; the file position is kept).
+  [[nodiscard]] double duration_s();
   [[nodiscard]] std::uint64_t chunks_read() const { return chunks_; }
   [[nodiscard]] std::uint64_t offset() const { return offset_; }
 
@@ -94,6 +98,7 @@ class Reader {
   std::string error_;
   std::uint64_t chunks_ = 0;
   std::uint64_t offset_ = 0;
+  std::uint64_t first_chunk_offset_ = 0;
   std::vector<std::uint8_t> buffer_;
 };
 

@@ -5,9 +5,12 @@
 // against the one recorded, and a difference stops the replay (diverged).
 //
 // Paced at `speed` times the recorded rate (0: as fast as it goes), on a
-// thread of its own; pause() and resume() hold it between ticks.
+// thread of its own; pause() and resume() hold it between ticks. seek()
+// runs to a position without pacing or VMC; backwards, it restarts the core
+// and the file and runs from the start (about 15x real time on this machine).
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <mutex>
@@ -52,12 +55,18 @@ class ReplayDriver {
   void pause() { paused_.store(true); }
   void resume() { paused_.store(false); }
   [[nodiscard]] bool paused() const { return paused_.load(); }
+  void seek(double position_s) { seek_to_s_.store(std::max(0.0, position_s)); }
+  // At the end, pause there (a page can seek back) instead of finishing.
+  void hold_at_end(bool hold) { hold_at_end_.store(hold); }
+  [[nodiscard]] double duration_s() const { return duration_s_; }
   [[nodiscard]] bool done() const { return done_.load(); }
   [[nodiscard]] ReplayStatus status() const;
 
  private:
+  enum class Step : std::uint8_t { next, stop, restart };
   void run();
-  bool replay_chunk(const recording::Chunk& chunk);  // false: stop
+  Step replay_chunk(const recording::Chunk& chunk);
+  void pace(std::int64_t now_us);
   void finish(ReplayEnd end, std::string error = {});
 
   PhysicsCore& core_;
@@ -65,7 +74,10 @@ class ReplayDriver {
   recording::Reader reader_;
   double speed_;
   std::thread thread_;
-  std::atomic<bool> stop_{false}, paused_{false}, done_{false};
+  std::atomic<bool> stop_{false}, paused_{false}, done_{false}, hold_at_end_{false};
+  std::atomic<double> seek_to_s_{-1.0};  // a pending seek (negative: none)
+  double fast_until_s_ = -1.0;           // running unpaced and silent up to here (a seek)
+  double duration_s_ = 0.0;
   mutable std::mutex mutex_;
   ReplayStatus status_;
   std::int64_t first_us_ = 0;
