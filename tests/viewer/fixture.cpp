@@ -1,10 +1,10 @@
 // tonus-viewer-fixture: the live viewer's server with synthetic but plausible
 // data, for the browser tests and for looking at the page without tonusd.
 //
-// The scene is tonus's humanoid (sim::build_humanoid: its bones and collision
-// shapes); each frame poses it by the physics core's own forward kinematics:
-// a gentle sway, arms half lowered, the reference a little ahead of the
-// avatar. Stiffness swells and ebbs per group. The page's requests go through
+// The scene is tonus's humanoid as tonusd describes it (make_viewer_scene: its
+// bones, collision shapes and stiffness groups); each frame poses it by the
+// physics core's own forward kinematics: a gentle sway, arms half lowered,
+// the reference a little ahead of the avatar. Stiffness swells and ebbs per group. The page's requests go through
 // the control API's own router (tonus::control::route) to a small handler,
 // exactly as tonusd's will: a thrown ball or a dropped cube appears in the
 // next frames, flies to its bone and falls to the ground.
@@ -32,6 +32,7 @@
 
 #include "tonus/host/control/api.hpp"
 #include "tonus/host/control/router.hpp"
+#include "tonus/host/daemon/viewer_feed.hpp"
 #include "tonus/host/viewer/server.hpp"
 #include "tonus/sim/data.hpp"
 #include "tonus/sim/human_bones.hpp"
@@ -49,60 +50,8 @@ constexpr double kPi = std::numbers::pi;
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int /*signal*/) { g_stop = true; }
 
-// The band's four groups (docs/protocol.md) and which bones each drives.
-constexpr std::array<const char*, 4> kGroups{"right_arm", "left_arm", "trunk", "legs"};
-int group_of(sim::Bone b) {
-  switch (b) {
-    case sim::Bone::RightShoulder:
-    case sim::Bone::RightUpperArm:
-    case sim::Bone::RightLowerArm:
-    case sim::Bone::RightHand: return 0;
-    case sim::Bone::LeftShoulder:
-    case sim::Bone::LeftUpperArm:
-    case sim::Bone::LeftLowerArm:
-    case sim::Bone::LeftHand: return 1;
-    case sim::Bone::Hips:
-    case sim::Bone::Spine:
-    case sim::Bone::Chest:
-    case sim::Bone::Neck:
-    case sim::Bone::Head: return 2;
-    default: return 3;
-  }
-}
-
 tv::Vec3 vec(const sim::Vec3& v) { return {v.x(), v.y(), v.z()}; }
 tv::QuatXyzw quat(const sim::Quat& q) { return {q.x(), q.y(), q.z(), q.w()}; }
-
-tv::Scene make_scene(const sim::Model& model, bool replay) {
-  tv::Scene scene;
-  scene.mode = replay ? "replay" : "live";
-  for (const sim::BoneInfo& b : sim::kBones) {
-    scene.bones.push_back(
-        {std::string(b.name), b.parent ? static_cast<int>(sim::index(*b.parent)) : -1, group_of(b.bone)});
-    scene.gift_bones.emplace_back(b.name);
-  }
-  for (int i = 0; i < model.ngeom; ++i) {
-    const sim::Geom& g = model.geoms[static_cast<std::size_t>(i)];
-    tv::GeomInfo info;
-    info.bone = g.body;
-    switch (g.shape.type) {
-      case sim::ShapeType::capsule: info.shape = "capsule"; break;
-      case sim::ShapeType::sphere: info.shape = "sphere"; break;
-      case sim::ShapeType::box: info.shape = "box"; break;
-      case sim::ShapeType::plane: continue;
-    }
-    info.radius_m = g.shape.radius_m;
-    info.half_length_m = g.shape.half_length_m;
-    info.half_extents_m = vec(g.shape.half_extents_m);
-    info.pos = vec(g.local.pos);
-    info.quat = quat(sim::Quat(g.local.rot));
-    scene.geoms.push_back(info);
-  }
-  scene.groups.assign(kGroups.begin(), kGroups.end());
-  scene.ground_z_m = 0.0;
-  scene.rate_hz = 1000.0;
-  return scene;
-}
 
 struct Gift {
   std::uint32_t id = 0;
@@ -279,7 +228,7 @@ int run(int argc, char** argv) {
   config.port = o.port;
   config.web_root = o.web_root;
   tv::ViewerServer viewer(config);
-  viewer.set_scene(make_scene(model, o.playback));
+  viewer.set_scene(tonus::daemon::make_viewer_scene(model, o.playback ? "replay" : "live"));  // as tonusd's
   viewer.set_request_handler([&handler](std::string_view method, std::string_view path, std::string_view body) {
     tc::Routed routed = tc::route(handler, method, path, body);
     return tv::RequestReply{routed.reply.status, std::move(routed.reply.body)};
@@ -346,7 +295,7 @@ int run(int argc, char** argv) {
     f.time_s = t;
     f.avatar = bone_poses(*avatar);
     f.reference = bone_poses(*reference);
-    for (std::size_t g = 0; g < kGroups.size(); ++g) {
+    for (std::size_t g = 0; g < tonus::avatar::kGroupCount; ++g) {
       const double swell = 0.5 + 0.42 * std::sin(2.0 * kPi * t / 4.0 + 0.9 * static_cast<double>(g));
       f.stiffness.push_back(override_levels ? (*override_levels)[g] : swell);
     }
