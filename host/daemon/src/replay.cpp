@@ -81,15 +81,19 @@ void ReplayDriver::run() {
       std::swap(current, ahead);
     }
     if (step == Step::stop) return;
-    // At the end with --hold: paused there until a page seeks back (or tonusd stops).
+    // At the end with --hold: paused there until a page seeks back, or plays
+    // (from the start, as a media player does), or tonusd stops.
     if (step == Step::next && next == recording::Reader::Status::end && hold_at_end_.load()) {
       paused_.store(true);
-      while (!stop_.load() && seek_to_s_.load() < 0.0) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      while (!stop_.load() && seek_to_s_.load() < 0.0 && paused_.load()) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
       if (stop_.load()) {
         finish(ReplayEnd::stopped);
         return;
       }
-      fast_until_s_ = seek_to_s_.exchange(-1.0);
+      const double target = seek_to_s_.exchange(-1.0);
+      fast_until_s_ = target > 0.0 ? target : -1.0;  // play: from the start, paced
       step = Step::restart;
     }
     if (step == Step::restart) {

@@ -56,7 +56,8 @@ class ReplayDriver {
   void resume() { paused_.store(false); }
   [[nodiscard]] bool paused() const { return paused_.load(); }
   void seek(double position_s) { seek_to_s_.store(std::max(0.0, position_s)); }
-  // At the end, pause there (a page can seek back) instead of finishing.
+  // At the end, pause there (a page can seek back, or play again from the
+  // start) instead of finishing.
   void hold_at_end(bool hold) { hold_at_end_.store(hold); }
   [[nodiscard]] double duration_s() const { return duration_s_; }
   [[nodiscard]] bool done() const { return done_.load(); }
