@@ -1,5 +1,6 @@
 #include "ltdl.hpp"
 
+#include <bit>
 #include <cstddef>
 
 namespace tonus::sim::ltdl {
@@ -27,6 +28,19 @@ void solve_lt(std::span<const double> f, int nv, std::span<const int> parent, in
   for (int k = nv - 1; k >= first; --k) {
     const double xk = x[static_cast<std::size_t>(k)];
     if (xk == 0.0) continue;  // rows of a contact Jacobian are zero off the contact's path
+    for (int i = up(parent, k); i >= first; i = up(parent, i)) x[static_cast<std::size_t>(i)] -= f[at(k, i, nv)] * xk;
+  }
+}
+
+void solve_lt_on(std::span<const double> f, int nv, std::span<const int> parent, int first, std::uint64_t support,
+                 std::span<double> x) {
+  // Highest dof first, as solve_lt: a dof's ancestors all have lower indices.
+  for (std::uint64_t bits = support; bits != 0;) {
+    const int k = 63 - std::countl_zero(bits);
+    bits &= ~(std::uint64_t{1} << static_cast<unsigned>(k));
+    if (k < first) break;
+    const double xk = x[static_cast<std::size_t>(k)];
+    if (xk == 0.0) continue;
     for (int i = up(parent, k); i >= first; i = up(parent, i)) x[static_cast<std::size_t>(i)] -= f[at(k, i, nv)] * xk;
   }
 }

@@ -9,6 +9,7 @@
 // or kinematic root's dofs are prescribed, not solved for).
 #pragma once
 
+#include <cstdint>
 #include <span>
 
 namespace tonus::sim::ltdl {
@@ -21,6 +22,11 @@ void solve(std::span<const double> f, int nv, std::span<const int> parent, int f
 
 // x <- L^-T x (the first half of a solve).
 void solve_lt(std::span<const double> f, int nv, std::span<const int> parent, int first, std::span<double> x);
+
+// x <- L^-T x where x is zero off `support`, a set of dofs closed under
+// ancestors (a row's paths to the root): touches those dofs only.
+void solve_lt_on(std::span<const double> f, int nv, std::span<const int> parent, int first, std::uint64_t support,
+                 std::span<double> x);
 
 // x <- L^-1 x (the second half, after scaling by D^-1).
 void solve_l(std::span<const double> f, int nv, std::span<const int> parent, int first, std::span<double> x);

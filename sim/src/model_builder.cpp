@@ -140,6 +140,8 @@ bool check_options(Checker& c, double dt, const Vec3& g, const Ground& ground, c
   if (s.torque_limit_passes < 0 || s.torque_limit_passes > 16)
     return c.fail("solver", "torque_limit_passes must be in [0, 16]");
   if (!finite(s.max_speed) || s.max_speed <= 0.0) return c.fail("solver", "max_speed must be > 0");
+  if (s.max_contacts < 1 || s.max_contacts > static_cast<int>(kMaxContacts))
+    return c.fail("solver", "max_contacts must be in [1, kMaxContacts]");
   return true;
 }
 

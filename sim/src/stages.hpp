@@ -48,7 +48,8 @@ void build_rows(const Model& model, Data& data);
 // Effective masses (J M~^-1 J^T), row velocities at v_free, targets.
 void assemble_rows(const Model& model, Data& data);
 
-// Projected Gauss-Seidel on the rows; then qvel and object velocities.
+// Projected Gauss-Seidel on the rows, island by island, to a residual
+// (solver.cpp); then qvel and object velocities.
 void solve_rows(const Model& model, Data& data);
 void apply_impulses(const Model& model, Data& data);
 
@@ -60,5 +61,6 @@ void integrate_objects(Data& data, const std::array<Vec3, kMaxObjects>& lin, con
 
 // Contact forces for the caller (impulse / dt) and warm-start memory.
 void report_contacts(const Model& model, Data& data);
+void remember_contacts(Data& data);  // this step's contacts, indexed by their sides, for the next warm start
 
 }  // namespace tonus::sim::detail

@@ -174,26 +174,26 @@ TEST_CASE("a gift with a lifetime of 0.5 s is gone 0.5 s later") {
   CHECK(c.gift_count() == 0);
 }
 
-TEST_CASE("over capacity the 17th gift is refused and the 16 others are untouched") {
+TEST_CASE("over capacity one more gift is refused and every other is untouched") {
   const TickInput in = rest_input();
   AvatarController c = settled(in);
-  REQUIRE(sim::kMaxObjects == 16);
+  constexpr auto kFull = static_cast<int>(sim::kMaxObjects);
   std::vector<GiftId> ids;
   for (size_t k = 0; k < sim::kMaxObjects; ++k) {
     SpawnResult r;
     if (k % 2 == 0) {
       DropCube d;
-      d.target = static_cast<Bone>(k + 1);
+      d.target = static_cast<Bone>(1 + k % (sim::kBoneCount - 1));
       r = c.drop_cube(d);
     } else {
       ThrowBall b;
-      b.target = static_cast<Bone>(k + 1);
+      b.target = static_cast<Bone>(1 + k % (sim::kBoneCount - 1));
       r = c.throw_ball(b);
     }
     REQUIRE(r.ok());
     ids.push_back(r.id);
   }
-  CHECK(c.gift_count() == 16);
+  CHECK(c.gift_count() == kFull);
   const std::array<sim::Object, sim::kMaxObjects> before = c.sim_b().objects;
   const std::uint64_t refused = c.stats().gifts_refused;
   const SpawnResult extra = c.throw_ball(ThrowBall{});
@@ -201,8 +201,8 @@ TEST_CASE("over capacity the 17th gift is refused and the 16 others are untouche
   CHECK_FALSE(extra.id.valid());
   CHECK(c.drop_cube(DropCube{}).error == GiftError::full);
   CHECK(c.stats().gifts_refused == refused + 2);
-  CHECK(c.stats().gifts_spawned == 16);
-  CHECK(c.gift_count() == 16);
+  CHECK(c.stats().gifts_spawned == static_cast<std::uint64_t>(kFull));
+  CHECK(c.gift_count() == kFull);
   for (size_t k = 0; k < sim::kMaxObjects; ++k) {
     const sim::Object& o = c.sim_b().objects[k];
     CHECK(o.active);
@@ -214,7 +214,7 @@ TEST_CASE("over capacity the 17th gift is refused and the 16 others are untouche
   // One removed: room for one more.
   CHECK(c.remove(ids[3]) == GiftError::none);
   CHECK(c.throw_ball(ThrowBall{}).ok());
-  CHECK(c.gift_count() == 16);
+  CHECK(c.gift_count() == kFull);
 }
 
 TEST_CASE(

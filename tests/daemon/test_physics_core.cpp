@@ -129,11 +129,14 @@ TEST_CASE("physics core: gifts show in the snapshot, a full scene refuses with a
   Command c;
   c.kind = Command::Kind::gift;
   c.gift = GiftKind::ball;
+  // In batches: the command queue holds fewer than kMaxObjects.
+  std::int64_t now_us = 0;
   for (std::uint32_t i = 0; i < sim::kMaxObjects + 2; ++i) {
     c.id = i;
     core->push_command(c);
+    if (i % 32 == 31) core->tick(now_us += 1000);
   }
-  core->tick(1000);
+  core->tick(now_us += 1000);
   REQUIRE(core->snapshots().update());
   const Snapshot& s = core->snapshots().read_slot();
   CHECK(s.nobjects == static_cast<int>(sim::kMaxObjects));
@@ -152,7 +155,7 @@ TEST_CASE("physics core: gifts show in the snapshot, a full scene refuses with a
   CHECK(refused == 2);
   c.kind = Command::Kind::clear_gifts;
   core->push_command(c);
-  core->tick(2000);
+  core->tick(now_us += 1000);
   REQUIRE(core->snapshots().update());
   CHECK(core->snapshots().read_slot().nobjects == 0);
 }

@@ -72,13 +72,19 @@ struct Contact {
 // wrong is counted here, and `last` tells the caller about the latest step.
 struct Diagnostics {
   std::uint32_t bad_inputs = 0;          // non-finite or absurd inputs replaced by safe values
-  std::uint32_t contact_overflow = 0;    // contact points dropped because kMaxContacts was reached
+  std::uint32_t contact_overflow = 0;    // contact points dropped for want of room (the least important go first)
   std::uint32_t limit_overflow = 0;      // joint-limit rows dropped
   std::uint32_t torque_saturations = 0;  // drive torques clamped at their limit
-  std::uint32_t solver_unconverged = 0;  // steps whose contact solve hit the iteration cap
+  std::uint32_t solver_unconverged = 0;  // steps whose constraint solve ended above the tolerance (sweep cap)
   std::uint32_t divergences = 0;         // steps rejected as diverging (state restored)
-  int solver_iterations = 0;             // last step
-  double solver_residual = 0.0;          // last step: largest row-velocity change in the final sweep (m/s, rad/s)
+  int solver_iterations = 0;             // last step: the most sweeps any island of contacts took
+  int solver_islands = 0;                // last step: independent groups solved
+  std::uint64_t solver_row_updates = 0;  // last step: row updates made (the solve's work)
+  // Last step: the velocity-level complementarity error at the impulses found,
+  // the largest over rows (m/s, rad/s): how far a row's velocity is from its
+  // target while it pushes, how fast it still closes while it does not, how
+  // far friction is from sticking or sliding at the cone. 0 without rows.
+  double solver_residual = 0.0;
 };
 
 enum class StepStatus : std::uint8_t {
@@ -182,26 +188,59 @@ struct Data {
     ContactSide a, b;
     Vec6 ua = Vec6::Zero();
     Vec6 ub = Vec6::Zero();
+    Vec3 ia = Vec3::Zero();  // an object side's world inverse inertia times ua's (ub's) angular part
+    Vec3 ib = Vec3::Zero();
+    double inv_mass_a = 0.0;  // an object side's inverse mass (0 for others)
+    double inv_mass_b = 0.0;
     int limit_body = -1;
     Vec3 limit_coef = Vec3::Zero();  // on the joint's dofs (the first dof_num entries)
     double target = 0.0;             // desired row velocity (gap closing, restitution, Baumgarte)
     double lambda = 0.0;             // impulse, N*s or N*m*s
     double cfm = 0.0;                // compliance of a drive row: 1 / (dt (Kd + dt Kp))
     double bound = 0.0;              // a drive row group's impulse limit (norm over the group)
+    double diag = 0.0;               // effective inverse mass along the row: (J M~^-1 J^T)_rr
+    double v0 = 0.0;                 // row velocity at the unconstrained end-of-step velocities
+    double pre = 0.0;                // row velocity at the start of the step
     int group = -1;                  // a drive row's first row (a ball joint's three rows are projected together)
     int contact = -1;
+    int island = -1;      // the independent group the row is solved in
+    int jac_offset = -1;  // its packed whitened Jacobian in jac_values (rows on the articulation)
+    int jac_size = 0;
     std::uint64_t support = 0;  // dofs the row touches (bit k: dof k)
   };
   std::array<Row, kMaxRows> rows{};
   int nrows = 0;
   int njoint_rows = 0;
-  int nbase_rows = 0;                                  // contact and limit rows; drive rows follow
-  std::array<double, kMaxRows * kMaxDofs> row_y{};     // D^-1/2 L^-T J^T per row
-  std::array<double, kMaxRows * kMaxRows> delassus{};  // J M~^-1 J^T
-  std::array<double, kMaxRows> row_v0{};               // row velocity at v_free
-  std::array<double, kMaxRows> row_pre{};              // row velocity at the start of the step
-  std::array<Contact, kMaxContacts> prev_contacts{};   // last step's, for warm starting
+  int nbase_rows = 0;  // contact and limit rows; drive rows follow
+  // y = D^-1/2 L^-T J^T of each row on the articulation (with M~ = L^T D L),
+  // packed over the row's support: (J M~^-1 J^T)_rs = y_r . y_s.
+  std::array<double, kRowJacobianPool> jac_values{};
+  std::array<std::uint8_t, kRowJacobianPool> jac_dofs{};
+  int jac_used = 0;
+  int jac_base_used = 0;  // taken by contact and limit rows; drive rows follow
+  // Solver state: the whitened impulse sum on the articulation (sum of y_r lambda_r)
+  // and each object's velocity change, so a row's velocity costs its own size only.
+  std::array<double, kMaxDofs> solve_w{};
+  std::array<Vec3, kMaxObjects> obj_dlin{};
+  std::array<Vec3, kMaxObjects> obj_dang{};
+  std::array<double, kMaxRows> solve_before{};                          // impulses before the sweep
+  std::array<double, kMaxRows> solve_dir{};                             // the conjugate direction (see solver.cpp)
+  std::array<double, kSubspaceRows * kSubspaceRows> subspace_matrix{};  // the subspace step (solver.cpp)
+  std::array<double, kSubspaceRows> subspace_rhs{};
+  std::array<int, kSubspaceRows> subspace_rows{};
+  // Islands: the articulation is node 0, object i node i + 1; rows joining
+  // nodes join their islands (the ground joins nothing).
+  std::array<int, kMaxObjects + 1> island_parent{};
+  std::array<int, kMaxObjects + 2> island_start{};  // rows of island s: island_rows[island_start[s] ..]
+  std::array<int, kMaxRows> island_rows{};
+  int nislands = 0;
+  std::array<Contact, kMaxContacts> prev_contacts{};    // last step's, for warm starting
+  std::array<std::uint64_t, kMaxContacts> prev_keys{};  // their side pairs, sorted with prev_order
+  std::array<std::uint16_t, kMaxContacts> prev_order{};
   int prev_ncon = 0;
+  // Contact selection past kMaxContacts: each contact's importance, and a min-heap over them.
+  std::array<double, kMaxContacts> contact_priority{};
+  std::array<std::uint16_t, kMaxContacts> contact_heap{};
 };
 
 // Allocates and initialises a Data for `model` at its rest configuration

@@ -123,15 +123,18 @@ struct Features {
 };
 
 struct SolverOptions {
-  int iterations = 60;               // projected Gauss-Seidel sweeps, at most
-  double tolerance = 1e-5;           // stop when no row's velocity moves by more than this in a sweep (m/s, rad/s)
-  double baumgarte = 0.2;            // fraction of a penetration corrected per step
-  double penetration_slop_m = 5e-4;  // penetration left alone (keeps resting contacts quiet)
-  double contact_margin_m = 0.01;    // speculative distance, plus what the shapes sweep in one step
+  int iterations = 200;                    // projected Gauss-Seidel sweeps per island, at most
+  double tolerance = 1e-6;                 // velocity-level residual to reach (m/s, rad/s); see solver.cpp
+  double baumgarte = 0.2;                  // fraction of a penetration corrected per step
+  double penetration_slop_m = 5e-4;        // penetration left alone (keeps resting contacts quiet)
+  double contact_margin_m = 0.01;          // speculative distance, plus what the shapes sweep in one step
   double restitution_threshold_mps = 0.5;  // slower impacts do not bounce
   double limit_margin_rad = 0.05;          // speculative angle for joint limits
   int torque_limit_passes = 4;             // re-solves when a drive saturates
   double max_speed = 1e4;                  // any generalized velocity beyond this (m/s or rad/s) is divergence
+  // Contact points kept per step, at most kMaxContacts: a lower cap bounds the
+  // solve's cost; past it the least important points go (see contacts.cpp).
+  int max_contacts = static_cast<int>(kMaxContacts);
 };
 
 // Semi-implicit Euler (MuJoCo's "Euler") is the real-time integrator: drives,

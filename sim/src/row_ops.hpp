@@ -1,0 +1,51 @@
+// A constraint row's velocity and the effect of an impulse along it, at the
+// cost of the row's own size: the articulation's share goes through the
+// whitened impulse sum (data.solve_w), an object's through its velocity
+// change. Shared by the row assembly (warm start) and the solver. Private to sim/.
+#pragma once
+
+#include <cstddef>
+
+#include "tonus/sim/data.hpp"
+
+namespace tonus::sim::detail {
+
+// Rows whose effective inverse mass is below this cannot move anything (a
+// kinematic body on the ground): their impulse stays 0.
+inline constexpr double kRowMinDiag = 1e-12;
+
+// The row's velocity at the current impulses.
+inline double row_velocity(const Data& data, const Data::Row& row) {
+  double v = row.v0;
+  const auto off = static_cast<std::size_t>(row.jac_offset < 0 ? 0 : row.jac_offset);
+  for (std::size_t j = 0; j < static_cast<std::size_t>(row.jac_size); ++j)
+    v += data.jac_values[off + j] * data.solve_w[data.jac_dofs[off + j]];
+  if (row.inv_mass_a > 0.0) {
+    const auto i = static_cast<std::size_t>(row.a.index);
+    v += row.ua.head<3>().dot(data.obj_dang[i]) + row.ua.tail<3>().dot(data.obj_dlin[i]);
+  }
+  if (row.inv_mass_b > 0.0) {
+    const auto i = static_cast<std::size_t>(row.b.index);
+    v += row.ub.head<3>().dot(data.obj_dang[i]) + row.ub.tail<3>().dot(data.obj_dlin[i]);
+  }
+  return v;
+}
+
+// Adds an impulse `delta` along the row to both sides.
+inline void apply_row_impulse(Data& data, const Data::Row& row, double delta) {
+  const auto off = static_cast<std::size_t>(row.jac_offset < 0 ? 0 : row.jac_offset);
+  for (std::size_t j = 0; j < static_cast<std::size_t>(row.jac_size); ++j)
+    data.solve_w[data.jac_dofs[off + j]] += data.jac_values[off + j] * delta;
+  if (row.inv_mass_a > 0.0) {
+    const auto i = static_cast<std::size_t>(row.a.index);
+    data.obj_dang[i] += row.ia * delta;
+    data.obj_dlin[i] += row.ua.tail<3>() * (row.inv_mass_a * delta);
+  }
+  if (row.inv_mass_b > 0.0) {
+    const auto i = static_cast<std::size_t>(row.b.index);
+    data.obj_dang[i] += row.ib * delta;
+    data.obj_dlin[i] += row.ub.tail<3>() * (row.inv_mass_b * delta);
+  }
+}
+
+}  // namespace tonus::sim::detail

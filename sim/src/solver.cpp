@@ -1,0 +1,482 @@
+// The constraint solve: projected Gauss-Seidel on the rows, island by island,
+// each to a velocity-level residual.
+//
+// Islands: rows that share no moving body cannot influence each other, so the
+// rows are split into independent groups (union-find over the articulation
+// and the objects; the ground joins nothing) and each group is solved on its
+// own and stops on its own: a ball at rest on the floor is done in a sweep
+// while a pile still settles. Within a group, rows are swept in their build
+// order (a contact's friction follows its normal row), so a step is
+// deterministic.
+//
+// A row's velocity is read through the running impulse sums (row_ops.hpp), so
+// a sweep costs the sum of the rows' sizes: linear in the number of rows.
+//
+// Convergence: the residual of a row is the velocity-level complementarity
+// error at the current impulses (the change in velocity one more projected
+// update of that row alone would make: |v - target| for a pushing normal row,
+// the closing speed of one that does not push, the slip of sticking friction
+// or the misalignment of sliding friction at the cone). A group stops when a
+// sweep changes no row by more than the tolerance and a pass that changes
+// nothing confirms every row is within it; the step reports the largest
+// residual left.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+
+#include "ltdl.hpp"
+#include "row_ops.hpp"
+#include "stages.hpp"
+
+namespace tonus::sim::detail {
+namespace {
+
+using std::size_t;
+using Row = Data::Row;
+
+int find_root(Data& data, int node) {
+  auto& parent = data.island_parent;
+  while (parent[static_cast<size_t>(node)] != node) {
+    parent[static_cast<size_t>(node)] = parent[static_cast<size_t>(parent[static_cast<size_t>(node)])];
+    node = parent[static_cast<size_t>(node)];
+  }
+  return node;
+}
+
+void join(Data& data, int x, int y) {
+  x = find_root(data, x);
+  y = find_root(data, y);
+  if (x == y) return;
+  // The lower node stays the root: the articulation (node 0) roots its island.
+  if (x < y) {
+    data.island_parent[static_cast<size_t>(y)] = x;
+  } else {
+    data.island_parent[static_cast<size_t>(x)] = y;
+  }
+}
+
+int side_node(const ContactSide& s) {
+  switch (s.kind) {
+    case ContactSide::Kind::body: return 0;
+    case ContactSide::Kind::object: return s.index + 1;
+    case ContactSide::Kind::ground: return -1;
+  }
+  return -1;
+}
+
+bool is_joint_row(const Row& r) { return r.kind == Row::Kind::limit || r.kind == Row::Kind::drive; }
+
+// Partitions the rows into islands, keeping their order within each.
+void build_islands(Data& data) {
+  const auto n = static_cast<size_t>(data.nrows);
+  constexpr size_t kNodes = kMaxObjects + 1;
+  for (size_t i = 0; i < kNodes; ++i) data.island_parent[i] = static_cast<int>(i);
+  for (size_t r = 0; r < n; ++r) {
+    const Row& row = data.rows[r];
+    if (is_joint_row(row)) continue;  // on the articulation alone
+    const int a = side_node(row.a), b = side_node(row.b);
+    if (a >= 0 && b >= 0) join(data, a, b);
+  }
+  // Number the islands that have rows, in order of their first row.
+  std::array<int, kNodes> number{};
+  number.fill(-1);
+  std::array<int, kNodes + 1> count{};
+  int islands = 0;
+  for (size_t r = 0; r < n; ++r) {
+    Row& row = data.rows[r];
+    const int node = is_joint_row(row) ? 0 : std::max(side_node(row.a), side_node(row.b));
+    const auto root = static_cast<size_t>(find_root(data, node));
+    if (number[root] < 0) number[root] = islands++;
+    row.island = number[root];
+    ++count[static_cast<size_t>(row.island)];
+  }
+  data.nislands = islands;
+  data.island_start[0] = 0;
+  for (size_t s = 0; s < static_cast<size_t>(islands); ++s) data.island_start[s + 1] = data.island_start[s] + count[s];
+  std::array<int, kNodes + 1> fill{};
+  std::copy_n(data.island_start.begin(), islands, fill.begin());
+  for (size_t r = 0; r < n; ++r) {
+    const auto s = static_cast<size_t>(data.rows[r].island);
+    data.island_rows[static_cast<size_t>(fill[s]++)] = static_cast<int>(r);
+  }
+}
+
+// One projected update of the unit (a row, a contact's friction pair, a
+// drive's group) starting at island_rows[p]. Returns the largest velocity
+// change it makes (or would make, when !apply) and the number of rows it spans.
+struct UnitResult {
+  double residual = 0.0;
+  int rows = 1;
+};
+
+UnitResult update_unit(Data& data, int first_row, bool apply) {
+  const auto r = static_cast<size_t>(first_row);
+  Row& row = data.rows[r];
+  switch (row.kind) {
+    case Row::Kind::normal:
+    case Row::Kind::limit: {
+      if (!(row.diag > kRowMinDiag)) return {};
+      const double next = std::max(0.0, row.lambda + (row.target - row_velocity(data, row)) / row.diag);
+      const double delta = next - row.lambda;
+      if (apply && delta != 0.0) {
+        apply_row_impulse(data, row, delta);
+        row.lambda = next;
+      }
+      return {std::abs(delta) * row.diag, 1};
+    }
+    case Row::Kind::friction1: {
+      // Both tangent rows, then the projection onto the Coulomb disc of the
+      // contact's normal impulse (the row before).
+      Row& row2 = data.rows[r + 1];
+      const double a11 = row.diag, a22 = row2.diag;
+      double l1 = 0.0, l2 = 0.0;
+      if (a11 > kRowMinDiag) l1 = row.lambda - row_velocity(data, row) / a11;
+      if (a22 > kRowMinDiag) l2 = row2.lambda - row_velocity(data, row2) / a22;
+      const Contact& c = data.contacts[static_cast<size_t>(row.contact)];
+      const double cap = c.friction * std::max(0.0, data.rows[r - 1].lambda);
+      const double norm = std::sqrt(l1 * l1 + l2 * l2);
+      const double scale = norm > cap ? (norm > 0.0 ? cap / norm : 0.0) : 1.0;
+      l1 *= scale;
+      l2 *= scale;
+      const double d1 = l1 - row.lambda, d2 = l2 - row2.lambda;
+      if (apply) {
+        if (d1 != 0.0) apply_row_impulse(data, row, d1);
+        if (d2 != 0.0) apply_row_impulse(data, row2, d2);
+        row.lambda = l1;
+        row2.lambda = l2;
+      }
+      return {std::max(std::abs(d1) * a11, std::abs(d2) * a22), 2};
+    }
+    case Row::Kind::drive: {
+      // A drive's rows (one per dof of the joint), each a compliant target,
+      // then the group's torque bounded as a vector.
+      const auto n = static_cast<size_t>(data.nrows);
+      size_t last = r;
+      while (last + 1 < n && data.rows[last + 1].kind == Row::Kind::drive && data.rows[last + 1].group == row.group)
+        ++last;
+      double norm2 = 0.0;
+      std::array<double, 3> next{};
+      for (size_t k = r; k <= last; ++k) {
+        const Row& rk = data.rows[k];
+        const double akk = rk.diag + rk.cfm;
+        next[k - r] = rk.lambda + (rk.target - row_velocity(data, rk) - rk.cfm * rk.lambda) / akk;
+        norm2 += next[k - r] * next[k - r];
+      }
+      const double norm = std::sqrt(norm2);
+      const double scale = norm > row.bound ? row.bound / norm : 1.0;
+      double residual = 0.0;
+      for (size_t k = r; k <= last; ++k) {
+        Row& rk = data.rows[k];
+        const double l = next[k - r] * scale;
+        residual = std::max(residual, std::abs(l - rk.lambda) * (rk.diag + rk.cfm));
+        if (apply && l != rk.lambda) {
+          apply_row_impulse(data, rk, l - rk.lambda);
+          rk.lambda = l;
+        }
+      }
+      return {residual, static_cast<int>(last - r + 1)};
+    }
+    case Row::Kind::friction2: return {};  // with friction1
+  }
+  return {};
+}
+
+// One pass over an island's rows. With apply, a Gauss-Seidel sweep returning
+// the largest change made; without, the residual at the current impulses.
+double pass(Data& data, int begin, int end, bool apply, std::uint64_t& updates) {
+  double largest = 0.0;
+  for (int p = begin; p < end;) {
+    const UnitResult u = update_unit(data, data.island_rows[static_cast<size_t>(p)], apply);
+    largest = std::max(largest, u.residual);
+    p += u.rows;
+    updates += static_cast<std::uint64_t>(u.rows);
+  }
+  return largest;
+}
+
+// Nonsmooth nonlinear conjugate gradients (Silcowitz, Niebe, Erleben 2010):
+// a projected Gauss-Seidel sweep is a descent step, and its change g is
+// taken as the negative gradient; adding beta times the previous direction,
+// beta = |g_k|^2 / |g_k-1|^2 (Fletcher-Reeves), with a restart whenever the
+// change grows. Redundant contacts on one body (sixteen points under two
+// feet) and heavy-light pairs (a ball on a 70 kg avatar) make plain sweeps
+// crawl; the momentum crosses those valleys in a few times fewer sweeps at
+// the cost of one more pass over the impulses. Impulses after a momentum
+// step may leave their cones; the next sweep projects them, and the solve
+// always ends on a sweep, so its impulses are feasible.
+void momentum(Data& data, int begin, int end, double& gg_prev, bool& have_dir) {
+  double gg = 0.0;
+  for (int p = begin; p < end; ++p) {
+    const auto r = static_cast<size_t>(data.island_rows[static_cast<size_t>(p)]);
+    const double g = data.rows[r].lambda - data.solve_before[r];
+    gg += g * g;
+  }
+  const double beta = have_dir && gg_prev > 0.0 ? gg / gg_prev : 0.0;
+  const bool restart = !(beta <= 1.0);
+  for (int p = begin; p < end; ++p) {
+    const auto r = static_cast<size_t>(data.island_rows[static_cast<size_t>(p)]);
+    Row& row = data.rows[r];
+    const double g = row.lambda - data.solve_before[r];
+    if (restart) {
+      data.solve_dir[r] = g;
+      continue;
+    }
+    const double step = beta * data.solve_dir[r];
+    if (step != 0.0) {
+      apply_row_impulse(data, row, step);
+      row.lambda += step;
+    }
+    data.solve_dir[r] = step + g;
+  }
+  gg_prev = gg;
+  have_dir = true;
+}
+
+// The subspace step (Silcowitz, Niebe, Erleben 2009, "projected Gauss-Seidel
+// subspace minimization"): sweeps find which rows push (normals and limits
+// with an impulse, friction inside its cone, drives inside their bound) long
+// before they find the impulses; those rows, held as equalities, are one
+// linear system (J M~^-1 J^T + compliance) dlambda = target - v, solved
+// directly. Sixteen points under two feet are redundant (more rows than the
+// legs have dofs): the factorisation drops the rows that depend on others. Sweeps then project the result and confirm
+// the active set; a wrong guess only costs the sweeps that fix it.
+// A pivot below this fraction of its row's own effective mass marks a dependent row.
+constexpr double kDependentPivot = 1e-8;
+
+bool is_sticking(const Data& data, size_t friction1) {
+  const Row& t1 = data.rows[friction1];
+  const Row& t2 = data.rows[friction1 + 1];
+  const double n = data.rows[friction1 - 1].lambda;
+  const double mu = data.contacts[static_cast<size_t>(t1.contact)].friction;
+  return n > 0.0 && std::sqrt(t1.lambda * t1.lambda + t2.lambda * t2.lambda) < mu * n * (1.0 - 1e-9);
+}
+
+bool is_active(const Data& data, size_t r) {
+  const Row& row = data.rows[r];
+  if (!(row.diag > kRowMinDiag)) return false;
+  switch (row.kind) {
+    case Row::Kind::normal:
+    case Row::Kind::limit: return row.lambda > 0.0;
+    case Row::Kind::friction1: return is_sticking(data, r);
+    case Row::Kind::friction2: return is_sticking(data, r - 1);
+    case Row::Kind::drive: {
+      double norm2 = 0.0;
+      const auto first = static_cast<size_t>(row.group);
+      for (size_t k = first; k < static_cast<size_t>(data.nrows) && data.rows[k].kind == Row::Kind::drive &&
+                             data.rows[k].group == row.group;
+           ++k)
+        norm2 += data.rows[k].lambda * data.rows[k].lambda;
+      return std::sqrt(norm2) < row.bound * (1.0 - 1e-9);
+    }
+  }
+  return false;
+}
+
+// u_r^T M_o^-1 u_s over the objects rows r and s share.
+double object_coupling(const Row& r, const Row& s) {
+  double a = 0.0;
+  const auto term = [&](const ContactSide& side_r, const Vec6& ur, const Vec3& ir, double inv_m) {
+    if (inv_m <= 0.0) return;
+    if (s.inv_mass_a > 0.0 && s.a.index == side_r.index)
+      a += s.ua.head<3>().dot(ir) + inv_m * s.ua.tail<3>().dot(ur.tail<3>());
+    if (s.inv_mass_b > 0.0 && s.b.index == side_r.index)
+      a += s.ub.head<3>().dot(ir) + inv_m * s.ub.tail<3>().dot(ur.tail<3>());
+  };
+  term(r.a, r.ua, r.ia, r.inv_mass_a);
+  term(r.b, r.ub, r.ib, r.inv_mass_b);
+  return a;
+}
+
+// Adds (sign = 1) or takes back (sign = -1) the subspace step's change.
+void apply_subspace(Data& data, size_t m, double sign) {
+  for (size_t i = 0; i < m; ++i) {
+    Row& row = data.rows[static_cast<size_t>(data.subspace_rows[i])];
+    const double delta = sign * data.subspace_rhs[i];
+    if (delta == 0.0) continue;
+    apply_row_impulse(data, row, delta);
+    row.lambda += delta;
+  }
+}
+
+// Returns false when there was nothing to do or no room (the island keeps
+// sweeping). Leaves the step in subspace_rhs for its first m rows.
+bool subspace_solve(Data& data, int begin, int end, size_t& m_out) {
+  int m = 0;
+  for (int p = begin; p < end; ++p) {
+    const auto r = static_cast<size_t>(data.island_rows[static_cast<size_t>(p)]);
+    if (!is_active(data, r)) continue;
+    if (m == static_cast<int>(kSubspaceRows)) return false;
+    data.subspace_rows[static_cast<size_t>(m++)] = static_cast<int>(r);
+  }
+  if (m == 0) return false;
+  const auto um = static_cast<size_t>(m);
+  m_out = um;
+  double* a = data.subspace_matrix.data();
+  double* b = data.subspace_rhs.data();
+  std::array<double, kMaxDofs> dense{};
+  for (size_t i = 0; i < um; ++i) {
+    const Row& ri = data.rows[static_cast<size_t>(data.subspace_rows[i])];
+    const auto oi = static_cast<size_t>(std::max(ri.jac_offset, 0));
+    for (size_t j = 0; j < static_cast<size_t>(ri.jac_size); ++j)
+      dense[data.jac_dofs[oi + j]] = data.jac_values[oi + j];
+    for (size_t k = 0; k <= i; ++k) {
+      const Row& rk = data.rows[static_cast<size_t>(data.subspace_rows[k])];
+      const auto ok = static_cast<size_t>(std::max(rk.jac_offset, 0));
+      double v = 0.0;
+      if ((ri.support & rk.support) != 0) {
+        for (size_t j = 0; j < static_cast<size_t>(rk.jac_size); ++j)
+          v += data.jac_values[ok + j] * dense[data.jac_dofs[ok + j]];
+      }
+      v += object_coupling(ri, rk);
+      a[i * um + k] = v;
+    }
+    for (size_t j = 0; j < static_cast<size_t>(ri.jac_size); ++j) dense[data.jac_dofs[oi + j]] = 0.0;
+    a[i * um + i] += ri.cfm;
+    const double target = ri.kind == Row::Kind::friction1 || ri.kind == Row::Kind::friction2 ? 0.0 : ri.target;
+    b[i] = target - row_velocity(data, ri) - ri.cfm * ri.lambda;
+  }
+  // Cholesky (lower) in place, dropping rows that depend on earlier ones:
+  // four points under a face are one row too many for a rigid body, and a
+  // pivot that vanishes marks such a row. It keeps no impulse change, so the
+  // others meet their targets exactly and nothing is amplified.
+  std::array<bool, kSubspaceRows> dependent{};
+  for (size_t j = 0; j < um; ++j) {
+    const double own = a[j * um + j];
+    double d = own;
+    for (size_t k = 0; k < j; ++k) d -= a[j * um + k] * a[j * um + k];
+    if (!(d > kDependentPivot * own) || !(own > 0.0)) {
+      dependent[j] = true;
+      a[j * um + j] = 1.0;
+      for (size_t i = j + 1; i < um; ++i) a[i * um + j] = 0.0;
+      continue;
+    }
+    d = std::sqrt(d);
+    a[j * um + j] = d;
+    for (size_t i = j + 1; i < um; ++i) {
+      double v = a[i * um + j];
+      for (size_t k = 0; k < j; ++k) v -= a[i * um + k] * a[j * um + k];
+      a[i * um + j] = v / d;
+    }
+  }
+  for (size_t i = 0; i < um; ++i) {
+    double v = b[i];
+    for (size_t k = 0; k < i; ++k) v -= a[i * um + k] * b[k];
+    b[i] = dependent[i] ? 0.0 : v / a[i * um + i];
+  }
+  for (size_t i = um; i-- > 0;) {
+    double v = b[i];
+    for (size_t k = i + 1; k < um; ++k) v -= a[k * um + i] * b[k];
+    b[i] = dependent[i] ? 0.0 : v / a[i * um + i];
+  }
+  for (size_t i = 0; i < um; ++i) {
+    if (!std::isfinite(b[i])) return false;
+  }
+  apply_subspace(data, um, 1.0);
+  return true;
+}
+
+}  // namespace
+
+// The subspace step, kept only when it lowers the island's residual: targets
+// that no rigid motion meets (four penetration depths under one face) have
+// no exact solution, and the step's least-squares answer can be far worse
+// than the sweeps' complementary one.
+bool subspace_step(Data& data, int begin, int end, std::uint64_t& updates) {
+  const double before = pass(data, begin, end, false, updates);
+  for (int p = begin; p < end; ++p) {
+    const auto r = static_cast<size_t>(data.island_rows[static_cast<size_t>(p)]);
+    data.solve_before[r] = data.rows[r].lambda;
+  }
+  size_t m = 0;
+  if (!subspace_solve(data, begin, end, m)) return false;
+  pass(data, begin, end, true, updates);  // projects the step back into the cones
+  const double after = pass(data, begin, end, false, updates);
+  if (after < before) return true;
+  for (int p = begin; p < end; ++p) {
+    const auto r = static_cast<size_t>(data.island_rows[static_cast<size_t>(p)]);
+    Row& row = data.rows[r];
+    const double back = data.solve_before[r] - row.lambda;
+    if (back == 0.0) continue;
+    apply_row_impulse(data, row, back);
+    row.lambda = data.solve_before[r];
+  }
+  return false;
+}
+
+// Sweeps before (and between) subspace steps: most islands converge in fewer.
+constexpr int kSubspaceEvery = 8;
+constexpr int kSubspaceMisses = 3;  // then the island only sweeps
+
+void solve_rows(const Model& model, Data& data) {
+  const SolverOptions& opt = model.solver;
+  build_islands(data);
+  int most_sweeps = 0;
+  double worst = 0.0;
+  bool unconverged = false;
+  std::uint64_t updates = 0;
+  for (size_t s = 0; s < static_cast<size_t>(data.nislands); ++s) {
+    const int begin = data.island_start[s], end = data.island_start[s + 1];
+    int sweeps = 0;
+    double residual = 0.0;
+    bool done = false;
+    double gg_prev = 0.0;
+    bool have_dir = false;
+    int subspace_misses = 0;
+    while (sweeps < opt.iterations) {
+      for (int p = begin; p < end; ++p) {
+        const auto r = static_cast<size_t>(data.island_rows[static_cast<size_t>(p)]);
+        data.solve_before[r] = data.rows[r].lambda;
+      }
+      const double change = pass(data, begin, end, true, updates);
+      ++sweeps;
+      if (change <= opt.tolerance) {
+        residual = pass(data, begin, end, false, updates);
+        if (residual <= opt.tolerance) {
+          done = true;
+          break;
+        }
+      }
+      if (sweeps >= opt.iterations) break;
+      if (subspace_misses < kSubspaceMisses && sweeps % kSubspaceEvery == 0) {
+        if (subspace_step(data, begin, end, updates)) {
+          have_dir = false;  // the direction belonged to the sweeps before
+          continue;
+        }
+        ++subspace_misses;  // it did not help this time
+      }
+      momentum(data, begin, end, gg_prev, have_dir);
+    }
+    if (!done) {
+      residual = pass(data, begin, end, false, updates);
+      unconverged = unconverged || residual > opt.tolerance;
+    }
+    most_sweeps = std::max(most_sweeps, sweeps);
+    worst = std::max(worst, residual);
+  }
+  data.diag.solver_iterations = most_sweeps;
+  data.diag.solver_islands = data.nislands;
+  data.diag.solver_row_updates = updates;
+  data.diag.solver_residual = worst;
+  if (unconverged) ++data.diag.solver_unconverged;
+}
+
+void apply_impulses(const Model& model, Data& data) {
+  const int nv = model.nv;
+  const int first = data.first_active_dof;
+  const auto unv = static_cast<size_t>(nv);
+  // dv = M~^-1 J^T lambda = L^-1 D^-1/2 (sum of y_r lambda_r).
+  std::array<double, kMaxDofs> z{};
+  std::copy_n(data.solve_w.begin(), unv, z.begin());
+  for (int k = first; k < nv; ++k) {
+    const auto ku = static_cast<size_t>(k);
+    z[ku] /= std::sqrt(data.factor[ku * unv + ku]);
+  }
+  ltdl::solve_l(data.factor, nv, model.dof_parent, first, std::span<double>(z).first(unv));
+  for (size_t k = 0; k < unv; ++k) data.qvel_next[k] = data.qvel_free[k] + (static_cast<int>(k) >= first ? z[k] : 0.0);
+  for (size_t i = 0; i < kMaxObjects; ++i) {
+    data.obj_lin_next[i] = data.obj_lin_free[i] + data.obj_dlin[i];
+    data.obj_ang_next[i] = data.obj_ang_free[i] + data.obj_dang[i];
+  }
+}
+
+}  // namespace tonus::sim::detail
