@@ -306,17 +306,24 @@ TEST_CASE("real clips: parsing the 2 MB CMU clip is fast and linear in its size"
   REQUIRE(count_at != std::string::npos);
   big.replace(count_at, 12, "Frames: 11008");
 
+  // The fastest of five parses of each: a busy machine (CI runs two builds'
+  // tests side by side) stretches single runs, never the best one.
   using Clock = std::chrono::steady_clock;
-  const auto t0 = Clock::now();
-  const ReadResult small = parse_bvh(text);
-  const auto t1 = Clock::now();
-  const ReadResult large = parse_bvh(big);
-  const auto t2 = Clock::now();
+  const auto fastest = [](const std::string& t, ReadResult& out) {
+    double best = 1e9;
+    for (int i = 0; i < 5; ++i) {
+      const auto t0 = Clock::now();
+      out = parse_bvh(t);
+      best = std::min(best, std::chrono::duration<double>(Clock::now() - t0).count());
+    }
+    return best;
+  };
+  ReadResult small, large;
+  const double small_s = fastest(text, small);
+  const double large_s = fastest(big, large);
   REQUIRE(small.ok());
   REQUIRE_MESSAGE(large.ok(), large.error->message);
   CHECK(large.clip.frame_count == 4 * 2752);
-  const double small_s = std::chrono::duration<double>(t1 - t0).count();
-  const double large_s = std::chrono::duration<double>(t2 - t1).count();
   MESSAGE("parse_bvh: ", text.size(), " bytes in ", small_s * 1e3, " ms; ", big.size(), " bytes in ", large_s * 1e3,
           " ms");
 #if defined(NDEBUG)
