@@ -1,6 +1,7 @@
 // Forward kinematics: body and geom poses, centres of mass, the motion axis
 // of every dof (and its rate) and the body velocities, all in the world frame
 // with spatial vectors taken at the root (data.origin).
+#include <algorithm>
 #include <cstddef>
 
 #include "spatial.hpp"
@@ -30,6 +31,8 @@ Quat joint_rotation(const Body& b, const std::array<double, kMaxQpos>& q) {
 void forward_kinematics(const Model& model, Data& data) {
   using namespace spatial;
   const auto nbody = static_cast<std::size_t>(model.nbody);
+  std::copy_n(data.qpos.begin(), model.nq, data.kinematics_qpos.begin());
+  std::copy_n(data.qvel.begin(), model.nv, data.kinematics_qvel.begin());
   for (std::size_t i = 0; i < nbody; ++i) {
     const Body& b = model.bodies[i];
     Quat xq;

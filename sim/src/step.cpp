@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 
 #include "stages.hpp"
 
@@ -174,9 +175,21 @@ void report_root_wrench(const Model& model, Data& data) {
   }
 }
 
+// The kinematics are a function of (qpos, qvel) alone: when the state is bit
+// for bit the one they were last computed at (the end of the previous step,
+// unless the caller changed it), they are still right.
+void refresh_kinematics(const Model& model, Data& data) {
+  const auto q_bytes = static_cast<size_t>(model.nq) * sizeof(double);
+  const auto v_bytes = static_cast<size_t>(model.nv) * sizeof(double);
+  if (std::memcmp(data.qpos.data(), data.kinematics_qpos.data(), q_bytes) == 0 &&
+      std::memcmp(data.qvel.data(), data.kinematics_qvel.data(), v_bytes) == 0)
+    return;
+  forward_kinematics(model, data);
+}
+
 // The real-time step: semi-implicit Euler with implicit drives and constraints.
 bool step_euler(const Model& model, Data& data, const StepInputs& inputs) {
-  forward_kinematics(model, data);
+  refresh_kinematics(model, data);
   mass_matrix(model, data);
   const std::array<double, kMaxDofs> zero{};
   inverse_dynamics(model, data, zero, data.bias);

@@ -142,6 +142,10 @@ struct Data {
   std::array<Vec6, kMaxBodies> cvel{};      // body spatial velocities (angular; linear at origin)
   std::array<Vec3, kMaxBodies> cinert_h{};  // spatial inertia about origin: first moment m * (com - origin)
   std::array<Mat3, kMaxBodies> cinert_i{};  // and rotational inertia about origin, world axes
+  // The state the kinematics above were computed at: a step whose state is
+  // bit for bit the one the previous step ended on skips recomputing them.
+  std::array<double, kMaxQpos> kinematics_qpos{};
+  std::array<double, kMaxDofs> kinematics_qvel{};
 
   // ---- dynamics scratch ----------------------------------------------------
   std::array<double, kMaxDofs * kMaxDofs> mass{};    // joint-space inertia, lower triangle, row stride nv
