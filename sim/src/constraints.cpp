@@ -37,29 +37,6 @@ std::uint64_t side_support(const Model& model, const ContactSide& s) {
   return s.kind == ContactSide::Kind::body ? model.body_path_dofs[static_cast<size_t>(s.index)] : 0;
 }
 
-// Room in the Jacobian pool for `count` rows on `support`, up to `limit` entries in all.
-bool reserve_jacobian(Data& data, Row& r, int count, std::size_t limit) {
-  const int size = std::popcount(r.support);
-  if (size == 0) {
-    r.jac_offset = -1;
-    r.jac_size = 0;
-    return true;
-  }
-  if (static_cast<std::size_t>(data.jac_used) + static_cast<std::size_t>(size) * static_cast<std::size_t>(count) >
-      limit)
-    return false;
-  r.jac_offset = data.jac_used;
-  r.jac_size = size;
-  return true;
-}
-
-bool add_row(Data& data, Row& r) {
-  if (data.nrows >= static_cast<int>(kMaxRows)) return false;
-  data.jac_used += r.jac_size;
-  data.rows[static_cast<size_t>(data.nrows++)] = r;
-  return true;
-}
-
 void limit_row(const Model& model, Data& data, int body, const Vec3& coef, double dist) {
   const double dt = model.timestep_s;
   Row r;
@@ -70,7 +47,7 @@ void limit_row(const Model& model, Data& data, int body, const Vec3& coef, doubl
   // Speculative while inside the range (may close the gap, not cross it);
   // Baumgarte-corrected once outside.
   r.target = dist > 0.0 ? -dist / dt : -model.solver.baumgarte * dist / dt;
-  if (data.njoint_rows >= static_cast<int>(kMaxJointRows) || !reserve_jacobian(data, r, 1, kRowJacobianPool) ||
+  if (data.njoint_rows >= static_cast<int>(kMaxJointRows) || !jacobian_fits(data, r.support, 1, kRowJacobianPool) ||
       !add_row(data, r)) {
     ++data.diag.limit_overflow;
     return;
@@ -123,7 +100,6 @@ double side_velocity(const Data& data, const ContactSide& s, const Vec6& u, bool
 }
 
 bool is_object(const ContactSide& s) { return s.kind == ContactSide::Kind::object; }
-bool is_joint_row(const Row& r) { return r.kind == Row::Kind::limit || r.kind == Row::Kind::drive; }
 
 }  // namespace
 
@@ -137,10 +113,8 @@ void build_rows(const Model& model, Data& data) {
     const std::uint64_t support = side_support(model, c.a) | side_support(model, c.b);
     const Vec3 dirs[3] = {c.normal, c.tangent1, c.tangent2};
     const int nrow = c.friction > 0.0 ? 3 : 1;
-    Row probe;
-    probe.support = support;
     if (data.nrows + nrow > static_cast<int>(kMaxRows - kMaxJointRows) ||
-        !reserve_jacobian(data, probe, nrow, kContactPool)) {
+        !jacobian_fits(data, support, nrow, kContactPool)) {
       ++data.diag.contact_overflow;
       continue;
     }
@@ -153,7 +127,6 @@ void build_rows(const Model& model, Data& data) {
       r.ub = -side_row(data, c.b, c.pos, dirs[k]);
       r.contact = ci;
       r.support = support;
-      reserve_jacobian(data, r, 1, kContactPool);
       r.lambda = c.impulse(k);  // warm start
       add_row(data, r);
     }

@@ -11,11 +11,11 @@
 // An explicit clamped torque would not do: on a light axis (an arm's twist)
 // it overshoots within one step and chatters.
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstddef>
 
 #include "ltdl.hpp"
+#include "row_ops.hpp"
 #include "stages.hpp"
 
 namespace tonus::sim::detail {
@@ -199,12 +199,9 @@ void add_drive_rows(const Model& model, Data& data) {
     bool compliant = true;
     for (size_t d = d0; d < d0 + static_cast<size_t>(b.dof_num); ++d)
       compliant = compliant && data.law_kd[d] + dt * data.law_kp[d] > 0.0;
-    const int jac_size = std::popcount(model.body_path_dofs[i]);
     const bool fits = data.nrows + b.dof_num <= static_cast<int>(kMaxRows) &&
                       data.njoint_rows + b.dof_num <= static_cast<int>(kMaxJointRows) &&
-                      static_cast<std::size_t>(data.jac_used) +
-                              static_cast<std::size_t>(b.dof_num) * static_cast<std::size_t>(jac_size) <=
-                          kRowJacobianPool;
+                      jacobian_fits(data, model.body_path_dofs[i], b.dof_num, kRowJacobianPool);
     if (!compliant || !fits) {
       // A constant feedforward alone, or no room: back to the inertia (unclamped, counted if for room).
       if (!fits) ++data.diag.limit_overflow;
@@ -231,10 +228,7 @@ void add_drive_rows(const Model& model, Data& data) {
       r.bound = data.drive_limit[i] * dt;
       r.group = group;
       r.lambda = data.drive_impulse[d];
-      r.jac_offset = data.jac_used;
-      r.jac_size = jac_size;
-      data.jac_used += jac_size;
-      data.rows[static_cast<size_t>(data.nrows++)] = r;
+      add_row(data, r);
       ++data.njoint_rows;
     }
   }

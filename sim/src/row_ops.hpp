@@ -4,7 +4,9 @@
 // change. Shared by the row assembly (warm start) and the solver. Private to sim/.
 #pragma once
 
+#include <bit>
 #include <cstddef>
+#include <cstdint>
 
 #include "tonus/sim/data.hpp"
 
@@ -13,6 +15,39 @@ namespace tonus::sim::detail {
 // Rows whose effective inverse mass is below this cannot move anything (a
 // kinematic body on the ground): their impulse stays 0.
 inline constexpr double kRowMinDiag = 1e-12;
+
+// Limit and drive rows act on their joint's own dofs; the others are contact rows.
+inline bool is_joint_row(const Data::Row& row) {
+  return row.kind == Data::Row::Kind::limit || row.kind == Data::Row::Kind::drive;
+}
+
+// One past the last row of the drive group that starts at row `first` (a ball
+// joint's three rows are projected together).
+inline std::size_t drive_group_end(const Data& data, std::size_t first) {
+  const int group = data.rows[first].group;
+  std::size_t end = first + 1;
+  while (end < static_cast<std::size_t>(data.nrows) && data.rows[end].kind == Data::Row::Kind::drive &&
+         data.rows[end].group == group)
+    ++end;
+  return end;
+}
+
+// Whether `rows` more rows on `support` fit the Jacobian pool below `limit` entries.
+inline bool jacobian_fits(const Data& data, std::uint64_t support, int rows, std::size_t limit) {
+  const auto size = static_cast<std::size_t>(std::popcount(support));
+  return static_cast<std::size_t>(data.jac_used) + size * static_cast<std::size_t>(rows) <= limit;
+}
+
+// Appends a row and gives it its place in the Jacobian pool (the caller
+// checked the pool's room). False when the rows are full.
+inline bool add_row(Data& data, Data::Row& row) {
+  if (data.nrows >= static_cast<int>(kMaxRows)) return false;
+  row.jac_size = std::popcount(row.support);
+  row.jac_offset = row.jac_size > 0 ? data.jac_used : -1;
+  data.jac_used += row.jac_size;
+  data.rows[static_cast<std::size_t>(data.nrows++)] = row;
+  return true;
+}
 
 // The row's velocity at the current impulses.
 inline double row_velocity(const Data& data, const Data::Row& row) {

@@ -64,8 +64,6 @@ int side_node(const ContactSide& s) {
   return -1;
 }
 
-bool is_joint_row(const Row& r) { return r.kind == Row::Kind::limit || r.kind == Row::Kind::drive; }
-
 // Partitions the rows into islands, keeping their order within each.
 void build_islands(Data& data) {
   const auto n = static_cast<size_t>(data.nrows);
@@ -150,10 +148,7 @@ UnitResult update_unit(Data& data, int first_row, bool apply) {
     case Row::Kind::drive: {
       // A drive's rows (one per dof of the joint), each a compliant target,
       // then the group's torque bounded as a vector.
-      const auto n = static_cast<size_t>(data.nrows);
-      size_t last = r;
-      while (last + 1 < n && data.rows[last + 1].kind == Row::Kind::drive && data.rows[last + 1].group == row.group)
-        ++last;
+      const size_t last = drive_group_end(data, r) - 1;
       double norm2 = 0.0;
       std::array<double, 3> next{};
       for (size_t k = r; k <= last; ++k) {
@@ -192,6 +187,26 @@ double pass(Data& data, int begin, int end, bool apply, std::uint64_t& updates) 
     updates += static_cast<std::uint64_t>(u.rows);
   }
   return largest;
+}
+
+// Keeps each island row's impulse in solve_before (the change of a sweep, a step to take back).
+void save_impulses(Data& data, int begin, int end) {
+  for (int p = begin; p < end; ++p) {
+    const auto r = static_cast<size_t>(data.island_rows[static_cast<size_t>(p)]);
+    data.solve_before[r] = data.rows[r].lambda;
+  }
+}
+
+// Back to the impulses save_impulses() kept.
+void restore_impulses(Data& data, int begin, int end) {
+  for (int p = begin; p < end; ++p) {
+    const auto r = static_cast<size_t>(data.island_rows[static_cast<size_t>(p)]);
+    Row& row = data.rows[r];
+    const double back = data.solve_before[r] - row.lambda;
+    if (back == 0.0) continue;
+    apply_row_impulse(data, row, back);
+    row.lambda = data.solve_before[r];
+  }
 }
 
 // Nonsmooth nonlinear conjugate gradients (Silcowitz, Niebe, Erleben 2010):
@@ -238,8 +253,10 @@ void momentum(Data& data, int begin, int end, double& gg_prev, bool& have_dir) {
 // before they find the impulses; those rows, held as equalities, are one
 // linear system (J M~^-1 J^T + compliance) dlambda = target - v, solved
 // directly. Sixteen points under two feet are redundant (more rows than the
-// legs have dofs): the factorisation drops the rows that depend on others. Sweeps then project the result and confirm
-// the active set; a wrong guess only costs the sweeps that fix it.
+// legs have dofs): the factorisation drops the rows that depend on others.
+// Sweeps then project the result and confirm the active set; a wrong guess
+// only costs the sweeps that fix it.
+
 // A pivot below this fraction of its row's own effective mass marks a dependent row.
 constexpr double kDependentPivot = 1e-8;
 
@@ -262,9 +279,7 @@ bool is_active(const Data& data, size_t r) {
     case Row::Kind::drive: {
       double norm2 = 0.0;
       const auto first = static_cast<size_t>(row.group);
-      for (size_t k = first; k < static_cast<size_t>(data.nrows) && data.rows[k].kind == Row::Kind::drive &&
-                             data.rows[k].group == row.group;
-           ++k)
+      for (size_t k = first, end = drive_group_end(data, first); k < end; ++k)
         norm2 += data.rows[k].lambda * data.rows[k].lambda;
       return std::sqrt(norm2) < row.bound * (1.0 - 1e-9);
     }
@@ -375,37 +390,27 @@ bool subspace_solve(Data& data, int begin, int end, size_t& m_out) {
   return true;
 }
 
-}  // namespace
-
 // The subspace step, kept only when it lowers the island's residual: targets
 // that no rigid motion meets (four penetration depths under one face) have
 // no exact solution, and the step's least-squares answer can be far worse
 // than the sweeps' complementary one.
 bool subspace_step(Data& data, int begin, int end, std::uint64_t& updates) {
   const double before = pass(data, begin, end, false, updates);
-  for (int p = begin; p < end; ++p) {
-    const auto r = static_cast<size_t>(data.island_rows[static_cast<size_t>(p)]);
-    data.solve_before[r] = data.rows[r].lambda;
-  }
+  save_impulses(data, begin, end);
   size_t m = 0;
   if (!subspace_solve(data, begin, end, m)) return false;
   pass(data, begin, end, true, updates);  // projects the step back into the cones
   const double after = pass(data, begin, end, false, updates);
   if (after < before) return true;
-  for (int p = begin; p < end; ++p) {
-    const auto r = static_cast<size_t>(data.island_rows[static_cast<size_t>(p)]);
-    Row& row = data.rows[r];
-    const double back = data.solve_before[r] - row.lambda;
-    if (back == 0.0) continue;
-    apply_row_impulse(data, row, back);
-    row.lambda = data.solve_before[r];
-  }
+  restore_impulses(data, begin, end);
   return false;
 }
 
 // Sweeps before (and between) subspace steps: most islands converge in fewer.
 constexpr int kSubspaceEvery = 8;
 constexpr int kSubspaceMisses = 3;  // then the island only sweeps
+
+}  // namespace
 
 void solve_rows(const Model& model, Data& data) {
   const SolverOptions& opt = model.solver;
@@ -423,10 +428,7 @@ void solve_rows(const Model& model, Data& data) {
     bool have_dir = false;
     int subspace_misses = 0;
     while (sweeps < opt.iterations) {
-      for (int p = begin; p < end; ++p) {
-        const auto r = static_cast<size_t>(data.island_rows[static_cast<size_t>(p)]);
-        data.solve_before[r] = data.rows[r].lambda;
-      }
+      save_impulses(data, begin, end);
       const double change = pass(data, begin, end, true, updates);
       ++sweeps;
       if (change <= opt.tolerance) {

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstring>
 
+#include "row_ops.hpp"
 #include "stages.hpp"
 
 namespace tonus::sim {
@@ -152,7 +153,7 @@ void report_kinematic_root_wrench(const Model& model, Data& data) {
   }
   for (int r = 0; r < data.nrows; ++r) {
     const Data::Row& row = data.rows[static_cast<size_t>(r)];
-    if (row.kind == Data::Row::Kind::limit || row.kind == Data::Row::Kind::drive || row.lambda == 0.0) continue;
+    if (detail::is_joint_row(row) || row.lambda == 0.0) continue;
     for (const auto* side : {&row.a, &row.b}) {
       if (side->kind != ContactSide::Kind::body) continue;
       const Vec6& u = side == &row.a ? row.ua : row.ub;
