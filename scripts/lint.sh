@@ -10,6 +10,11 @@ clang-format --dry-run --Werror "${sources[@]}"
 echo "lint: clang-format clean (${#sources[@]} files)"
 
 # clang-tidy on every translation unit of ours, each with the build that compiles it.
+# Each translation unit writes its own log: parallel runs sharing one pipe
+# interleave their "N warnings generated." lines into fragments no filter can
+# tell from a diagnostic.
+logs=$(mktemp -d)
+trap 'rm -rf "$logs"' EXIT
 tidy() {
   local build=$1
   shift
@@ -17,8 +22,12 @@ tidy() {
   # clang's -Wdouble-promotion flags every float passed to a double (the
   # firmware tests' checks); gcc's narrower check stays on in every build
   # (cmake/TonusOptions.cmake turns clang's off the same way).
-  printf '%s\n' "$@" | xargs -P "$(nproc)" -n 4 clang-tidy -p "$build" --quiet --extra-arg=-Wno-double-promotion 2>&1 |
-    grep -vE '^[0-9]+ warnings? (generated|treated)|^Suppressed|^Use -header-filter|^$' || true
+  printf '%s\n' "$@" | xargs -P "$(nproc)" -I{} sh -c \
+    'clang-tidy -p "$1" --quiet --extra-arg=-Wno-double-promotion "$2" >"$3/$(echo "$2" | tr / _).log" 2>&1' \
+    sh "$build" {} "$logs" || true
+  # A log may end without a newline ("N warnings generated." does): end each.
+  for log in "$logs"/*.log; do cat "$log" && echo; done | grep -vE '^[0-9]+ warnings? (generated|treated)|^Suppressed|^Use -header-filter|^$' || true
+  rm -f "$logs"/*.log
 }
 mapfile -t host_tus < <(git ls-files '*.cpp' | grep -vE '^tests/fuzz/|^firmware/targets/(cortex-m4|probe)/')
 mapfile -t fuzz_tus < <(git ls-files 'tests/fuzz/*.cpp')
