@@ -16,6 +16,16 @@ namespace tonus::sim::detail {
 // kinematic body on the ground): their impulse stays 0.
 inline constexpr double kRowMinDiag = 1e-12;
 
+// A normal or limit row's impulse is capped where it alone would change the
+// row's velocity by this much (m/s, rad/s). No real contact comes near it (a
+// 70 kg avatar standing on a 0.1 kg ball needs 7); it only binds where the
+// targets contradict the mechanism (a kinematic root pressing straight legs
+// into the floor asks the feet for a velocity no joint can give), and there it
+// keeps the impulses finite: a bounded problem always has a solution, an
+// unbounded one whose targets cannot be met has none, and its impulses grow
+// without limit sweep after sweep.
+inline constexpr double kMaxRowSpeedChange = 100.0;
+
 // Limit and drive rows act on their joint's own dofs; the others are contact rows.
 inline bool is_joint_row(const Data::Row& row) {
   return row.kind == Data::Row::Kind::limit || row.kind == Data::Row::Kind::drive;

@@ -5,6 +5,7 @@
 // the clamp of a configuration into the joint ranges.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "sim_fixtures.hpp"
@@ -157,10 +158,31 @@ TEST_CASE("a kinematic root standing on the ground: root wrench and ground force
   StepInputs in = make_inputs(*model);
   stiffen(*model, in);
   in.root_pos.z() -= 0.01;  // the feet pressed 1 cm into the ground: the ground takes part of the weight
-  for (int s = 0; s < 2000; ++s) REQUIRE(step(*model, *data, in) != StepStatus::diverged);
+  // Straight legs under a prescribed root cannot lift the feet (a straight
+  // knee gives the ankle no vertical velocity): the push-out targets contradict
+  // the mechanism and no finite impulse meets them. The solver's impulse cap
+  // keeps the problem solvable: the forces stay bounded and most steps still
+  // converge (uncapped, the ground pushed with 3e5 body weights in the first
+  // steps and 889 of 2000 steps ended at the sweep cap). The split between
+  // the ground and the root is indeterminate along straight legs (a force
+  // along the leg moves nothing), so only their sum is checked.
+  const double w = model->total_mass_kg() * kG;
+  double most = 0.0;
+  int unconverged = 0, airborne = 0;
+  for (int s = 0; s < 2000; ++s) {
+    REQUIRE(step(*model, *data, in) != StepStatus::diverged);
+    double push = 0.0;
+    for (int c = 0; c < data->ncon; ++c) push += data->contacts[static_cast<std::size_t>(c)].force_world.norm();
+    most = std::max(most, push);
+    if (data->diag.solver_residual > model->solver.tolerance) ++unconverged;
+    if (data->ncon == 0) ++airborne;
+  }
+  MESSAGE("largest ground force " << most / w << " body weights, " << unconverged << " of 2000 steps unconverged");
+  CHECK(most < 1e4 * w);
+  CHECK(unconverged < 200);
+  CHECK(airborne == 0);
   double ground = 0.0;
   for (int c = 0; c < data->ncon; ++c) ground += data->contacts[static_cast<std::size_t>(c)].force_world.z();
-  const double w = model->total_mass_kg() * kG;
   MESSAGE("ground " << ground << " N, root " << data->root_wrench_force.z() << " N, weight " << w << " N");
   CHECK(std::abs(ground) > 0.05 * w);
   CHECK(ground + data->root_wrench_force.z() == doctest::Approx(w).epsilon(2e-3));
