@@ -21,6 +21,7 @@
 // nothing confirms every row is within it; the step reports the largest
 // residual left.
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 
@@ -302,6 +303,26 @@ double object_coupling(const Row& r, const Row& s) {
   return a;
 }
 
+// Dense dot product through Eigen (vectorised, in Eigen's fixed order).
+double dot(const double* x, const double* y, size_t n) {
+  if (n == 0) return 0.0;
+  const auto len = static_cast<Eigen::Index>(n);
+  return Eigen::Map<const Eigen::VectorXd>(x, len).dot(Eigen::Map<const Eigen::VectorXd>(y, len));
+}
+
+// Two rows' shared dofs, when they are the lowest dofs of both supports (a
+// row's support is its bodies' paths to the root, dofs numbered root first,
+// so two single-path rows share the path to their common ancestor, which
+// leads both packed rows): their number. -1 when they share dofs otherwise.
+int shared_prefix(std::uint64_t a, std::uint64_t b) {
+  const std::uint64_t both = a & b;
+  if (both == 0) return 0;
+  const auto top = static_cast<unsigned>(63 - std::countl_zero(both));
+  const std::uint64_t below = top == 63 ? ~std::uint64_t{0} : (std::uint64_t{2} << top) - 1;
+  if ((a & below) != both || (b & below) != both) return -1;
+  return std::popcount(both);
+}
+
 // Adds (sign = 1) or takes back (sign = -1) the subspace step's change.
 void apply_subspace(Data& data, size_t m, double sign) {
   for (size_t i = 0; i < m; ++i) {
@@ -334,15 +355,24 @@ bool subspace_solve(Data& data, int begin, int end, size_t& m_out) {
     const auto oi = static_cast<size_t>(std::max(ri.jac_offset, 0));
     for (size_t j = 0; j < static_cast<size_t>(ri.jac_size); ++j)
       dense[data.jac_dofs[oi + j]] = data.jac_values[oi + j];
+    std::uint64_t seen_support = 0;
+    int seen_shared = 0;
     for (size_t k = 0; k <= i; ++k) {
       const Row& rk = data.rows[static_cast<size_t>(data.subspace_rows[k])];
       const auto ok = static_cast<size_t>(std::max(rk.jac_offset, 0));
       double v = 0.0;
-      if ((ri.support & rk.support) != 0) {
+      if (rk.support != seen_support) {  // rows of one body come together and share their support
+        seen_support = rk.support;
+        seen_shared = shared_prefix(ri.support, rk.support);
+      }
+      if (seen_shared >= 0) {
+        // The shared dofs lead both packed rows: a contiguous dot product.
+        v = dot(&data.jac_values[ok], &data.jac_values[oi], static_cast<size_t>(seen_shared));
+      } else {
         for (size_t j = 0; j < static_cast<size_t>(rk.jac_size); ++j)
           v += data.jac_values[ok + j] * dense[data.jac_dofs[ok + j]];
       }
-      v += object_coupling(ri, rk);
+      if (ri.inv_mass_a > 0.0 || ri.inv_mass_b > 0.0) v += object_coupling(ri, rk);
       a[i * um + k] = v;
     }
     for (size_t j = 0; j < static_cast<size_t>(ri.jac_size); ++j) dense[data.jac_dofs[oi + j]] = 0.0;
@@ -357,8 +387,7 @@ bool subspace_solve(Data& data, int begin, int end, size_t& m_out) {
   std::array<bool, kSubspaceRows> dependent{};
   for (size_t j = 0; j < um; ++j) {
     const double own = a[j * um + j];
-    double d = own;
-    for (size_t k = 0; k < j; ++k) d -= a[j * um + k] * a[j * um + k];
+    double d = own - dot(&a[j * um], &a[j * um], j);
     if (!(d > kDependentPivot * own) || !(own > 0.0)) {
       dependent[j] = true;
       a[j * um + j] = 1.0;
@@ -368,14 +397,11 @@ bool subspace_solve(Data& data, int begin, int end, size_t& m_out) {
     d = std::sqrt(d);
     a[j * um + j] = d;
     for (size_t i = j + 1; i < um; ++i) {
-      double v = a[i * um + j];
-      for (size_t k = 0; k < j; ++k) v -= a[i * um + k] * a[j * um + k];
-      a[i * um + j] = v / d;
+      a[i * um + j] = (a[i * um + j] - dot(&a[i * um], &a[j * um], j)) / d;
     }
   }
   for (size_t i = 0; i < um; ++i) {
-    double v = b[i];
-    for (size_t k = 0; k < i; ++k) v -= a[i * um + k] * b[k];
+    const double v = b[i] - dot(&a[i * um], b, i);
     b[i] = dependent[i] ? 0.0 : v / a[i * um + i];
   }
   for (size_t i = um; i-- > 0;) {
@@ -407,10 +433,12 @@ bool subspace_step(Data& data, int begin, int end, std::uint64_t& updates) {
 }
 
 // Sweeps before the first subspace step and between later ones. Most islands
-// converge in one sweep from the warm start; one still moving after two (a
-// standing avatar rocking on its toes) crawls for eight or more, and an early
-// subspace step halves its sweeps (lively scene: 9.1 to 4.2 a step).
-constexpr int kSubspaceFirst = 2;
+// converge in one sweep from the warm start; one still moving after it (a
+// standing avatar rocking on its toes, balls landing) crawls for eight or
+// more, and a subspace step right away saves most of them (lively scene:
+// 9.1 sweeps a step with the first step after 8, 2.9 after 1; shower100's
+// p99 200 to about 100).
+constexpr int kSubspaceFirst = 1;
 constexpr int kSubspaceEvery = 8;
 constexpr int kSubspaceMisses = 3;  // then the island only sweeps
 
