@@ -151,6 +151,7 @@ void assemble_rows(const Model& model, Data& data) {
   data.obj_dang.fill(Vec3::Zero());
 
   std::array<double, kMaxDofs> y{};
+  ltdl::PathFactor path;  // the last chain gathered: rows on one body come together
   for (size_t r = 0; r < n; ++r) {
     Row& row = data.rows[r];
     double v_pre = side_velocity(data, row.a, row.ua, false) + side_velocity(data, row.b, row.ub, false);
@@ -185,7 +186,12 @@ void assemble_rows(const Model& model, Data& data) {
         const auto k = static_cast<size_t>(std::countr_zero(bits));
         if (static_cast<int>(k) < first) y[k] = 0.0;
       }
-      ltdl::solve_lt_on(data.factor, nv, model.dof_parent, first, row.support, std::span<double>(y).first(unv));
+      if (row.support != path.support &&
+          !ltdl::gather_path(data.factor, nv, model.dof_parent, first, row.support, path)) {
+        ltdl::solve_lt_on(data.factor, nv, model.dof_parent, first, row.support, std::span<double>(y).first(unv));
+      } else {
+        ltdl::solve_lt_path(path, std::span<double>(y).first(unv));
+      }
       auto at = static_cast<size_t>(row.jac_offset);
       for (std::uint64_t bits = row.support; bits != 0; bits &= bits - 1, ++at) {
         const auto k = static_cast<size_t>(std::countr_zero(bits));

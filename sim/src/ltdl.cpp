@@ -45,6 +45,44 @@ void solve_lt_on(std::span<const double> f, int nv, std::span<const int> parent,
   }
 }
 
+bool gather_path(std::span<const double> f, int nv, std::span<const int> parent, int first, std::uint64_t support,
+                 PathFactor& p) {
+  p.support = 0;
+  int size = 0, begin = -1, prev = -1;
+  for (std::uint64_t bits = support; bits != 0; bits &= bits - 1) {
+    const int k = std::countr_zero(bits);
+    if (up(parent, k) != prev) return false;  // a branch: not one path
+    p.dofs[static_cast<std::size_t>(size)] = static_cast<std::uint8_t>(k);
+    if (begin < 0 && k >= first) begin = size;
+    prev = k;
+    ++size;
+  }
+  if (begin < 0) begin = size;
+  for (int j = begin; j < size; ++j) {
+    const int kj = p.dofs[static_cast<std::size_t>(j)];
+    for (int i = begin; i < j; ++i)
+      p.l[static_cast<std::size_t>(j) * kMaxDofs + static_cast<std::size_t>(i)] =
+          f[at(kj, p.dofs[static_cast<std::size_t>(i)], nv)];
+  }
+  p.support = support;
+  p.begin = begin;
+  p.size = size;
+  return true;
+}
+
+void solve_lt_path(const PathFactor& p, std::span<double> x) {
+  std::array<double, kMaxDofs> xp;
+  const auto begin = static_cast<std::size_t>(p.begin), size = static_cast<std::size_t>(p.size);
+  for (std::size_t j = begin; j < size; ++j) xp[j] = x[p.dofs[j]];
+  for (std::size_t j = size; j-- > begin;) {
+    const double xj = xp[j];
+    if (xj == 0.0) continue;
+    const double* lj = &p.l[j * kMaxDofs];
+    for (std::size_t i = begin; i < j; ++i) xp[i] -= lj[i] * xj;
+  }
+  for (std::size_t j = begin; j < size; ++j) x[p.dofs[j]] = xp[j];
+}
+
 void solve_l(std::span<const double> f, int nv, std::span<const int> parent, int first, std::span<double> x) {
   for (int k = first; k < nv; ++k) {
     double s = x[static_cast<std::size_t>(k)];
