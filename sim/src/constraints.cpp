@@ -7,7 +7,10 @@
 // only on the dofs of the row's path(s) to the root, and
 // (J M~^-1 J^T)_rs = y_r . y_s. Each row keeps its y packed over its support;
 // no matrix of row pairs is ever formed, so the cost and the memory grow
-// with the number of rows, not its square.
+// with the number of rows, not its square. A contact on one body (J^T = S^T u,
+// S the path's motion axes, u the contact's spatial direction) takes its y
+// from the body's six whitened axes, y = (D^-1/2 L^-T S^T) u, computed once
+// per body: a foot's four points are twelve rows but six solves.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -101,6 +104,120 @@ double side_velocity(const Data& data, const ContactSide& s, const Vec6& u, bool
 
 bool is_object(const ContactSide& s) { return s.kind == ContactSide::Kind::object; }
 
+// The body of a contact row with one side on the articulation (the other on
+// the ground or an object), whose support is that body's path; else -1.
+int single_body(const Row& row) {
+  if (is_joint_row(row)) return -1;
+  const bool a = row.a.kind == ContactSide::Kind::body, b = row.b.kind == ContactSide::Kind::body;
+  if (a == b) return -1;
+  return a ? row.a.index : row.b.index;
+}
+
+// A body's six whitened spatial axes: W[a] = D^-1/2 L^-T S^T e_a over the
+// body's path (S: the path's motion axes, cdof), packed in path order. A
+// contact row on the body, of spatial direction u, is then y = sum_a u_a W[a]:
+// six solves per body instead of one per row (a foot's four points are twelve
+// rows), and no J^T to build.
+struct BodyAxes {
+  int body = -1;
+  bool ok = false;  // the path is a chain (always, for a tree's body)
+  ltdl::PathFactor path;
+  std::array<std::array<double, kMaxDofs>, 6> w;
+  Vec6 v_pre = Vec6::Zero(), v_free = Vec6::Zero();  // the body's twist (world, at the origin) now and free
+
+  // Writes the row's packed y and returns |y|^2.
+  double whiten(const Vec6& u, double* values, std::uint8_t* dofs) const {
+    const auto n = static_cast<size_t>(path.size);
+    for (size_t j = 0; j < n; ++j) values[j] = u(0) * w[0][j];
+    for (size_t a = 1; a < 6; ++a) {
+      const double ua = u(static_cast<Eigen::Index>(a));
+      for (size_t j = 0; j < n; ++j) values[j] += ua * w[a][j];
+    }
+    double norm2 = 0.0;
+    for (size_t j = 0; j < n; ++j) {
+      dofs[j] = path.dofs[j];
+      norm2 += values[j] * values[j];
+    }
+    return norm2;
+  }
+};
+
+void load_axes(const Model& model, const Data& data, int body, const std::array<double, kMaxDofs>& inv_sqrt_d,
+               BodyAxes& axes) {
+  axes.body = body;
+  const int nv = model.nv, first = data.first_active_dof;
+  axes.ok = ltdl::gather_path(data.factor, nv, model.dof_parent, first, model.body_path_dofs[static_cast<size_t>(body)],
+                              axes.path);
+  if (!axes.ok) return;
+  const ltdl::PathFactor& p = axes.path;
+  const auto begin = static_cast<size_t>(p.begin), n = static_cast<size_t>(p.size);
+  axes.v_pre.setZero();
+  axes.v_free.setZero();
+  for (size_t j = 0; j < n; ++j) {
+    const auto k = static_cast<size_t>(p.dofs[j]);
+    axes.v_pre += data.cdof[k] * data.qvel[k];
+    axes.v_free += data.cdof[k] * data.qvel_free[k];
+  }
+  std::array<double, kMaxDofs> x;
+  for (size_t a = 0; a < 6; ++a) {
+    const auto ai = static_cast<Eigen::Index>(a);
+    for (size_t j = begin; j < n; ++j) x[p.dofs[j]] = data.cdof[p.dofs[j]](ai);
+    ltdl::solve_lt_path(p, std::span<double>(x).first(static_cast<size_t>(nv)));
+    // Prescribed dofs do not yield.
+    for (size_t j = 0; j < begin; ++j) axes.w[a][j] = 0.0;
+    for (size_t j = begin; j < n; ++j) axes.w[a][j] = x[p.dofs[j]] * inv_sqrt_d[p.dofs[j]];
+  }
+}
+
+// Any other row (a joint's, or a contact between two bodies): J^T on the
+// support, then the L^-T solve. Returns |y|^2 and adds J qvel to v_pre and v_free.
+double whiten_row(const Model& model, Data& data, const Row& row, const std::array<double, kMaxDofs>& inv_sqrt_d,
+                  ltdl::PathFactor& path, double& v_pre, double& v_free) {
+  const int nv = model.nv, first = data.first_active_dof;
+  const auto unv = static_cast<size_t>(nv);
+  std::array<double, kMaxDofs> y;
+  for (std::uint64_t bits = row.support; bits != 0; bits &= bits - 1)
+    y[static_cast<size_t>(std::countr_zero(bits))] = 0.0;
+  if (is_joint_row(row)) {
+    const Body& b = model.bodies[static_cast<size_t>(row.limit_body)];
+    for (int k = 0; k < b.dof_num; ++k) y[static_cast<size_t>(b.dof_adr) + static_cast<size_t>(k)] = row.limit_coef(k);
+  } else {
+    for (const auto* side : {&row.a, &row.b}) {
+      if (side->kind != ContactSide::Kind::body) continue;
+      const Vec6& u = side == &row.a ? row.ua : row.ub;
+      for (std::uint64_t bits = model.body_path_dofs[static_cast<size_t>(side->index)]; bits != 0; bits &= bits - 1) {
+        const auto k = static_cast<size_t>(std::countr_zero(bits));
+        y[k] += u.dot(data.cdof[k]);
+      }
+    }
+  }
+  for (std::uint64_t bits = row.support; bits != 0; bits &= bits - 1) {
+    const auto k = static_cast<size_t>(std::countr_zero(bits));
+    v_pre += y[k] * data.qvel[k];
+    v_free += y[k] * data.qvel_free[k];
+  }
+  // Prescribed dofs do not yield; the solve stays on the support (L has the tree's sparsity).
+  for (std::uint64_t bits = row.support; bits != 0; bits &= bits - 1) {
+    const auto k = static_cast<size_t>(std::countr_zero(bits));
+    if (static_cast<int>(k) < first) y[k] = 0.0;
+  }
+  if (row.support != path.support && !ltdl::gather_path(data.factor, nv, model.dof_parent, first, row.support, path)) {
+    ltdl::solve_lt_on(data.factor, nv, model.dof_parent, first, row.support, std::span<double>(y).first(unv));
+  } else {
+    ltdl::solve_lt_path(path, std::span<double>(y).first(unv));
+  }
+  double norm2 = 0.0;
+  auto at = static_cast<size_t>(row.jac_offset);
+  for (std::uint64_t bits = row.support; bits != 0; bits &= bits - 1, ++at) {
+    const auto k = static_cast<size_t>(std::countr_zero(bits));
+    const double yk = static_cast<int>(k) >= first ? y[k] * inv_sqrt_d[k] : 0.0;
+    data.jac_values[at] = yk;
+    data.jac_dofs[at] = static_cast<std::uint8_t>(k);
+    norm2 += yk * yk;
+  }
+  return norm2;
+}
+
 }  // namespace
 
 void build_rows(const Model& model, Data& data) {
@@ -150,56 +267,24 @@ void assemble_rows(const Model& model, Data& data) {
   data.obj_dlin.fill(Vec3::Zero());
   data.obj_dang.fill(Vec3::Zero());
 
-  std::array<double, kMaxDofs> y{};
-  ltdl::PathFactor path;  // the last chain gathered: rows on one body come together
+  // The last body's axes and the last path gathered: rows on one body come together.
+  BodyAxes axes;
+  ltdl::PathFactor path;
   for (size_t r = 0; r < n; ++r) {
     Row& row = data.rows[r];
     double v_pre = side_velocity(data, row.a, row.ua, false) + side_velocity(data, row.b, row.ub, false);
     double v_free = side_velocity(data, row.a, row.ua, true) + side_velocity(data, row.b, row.ub, true);
     double diag = 0.0;
-    if (row.jac_size > 0) {
-      // J on the articulation, over the row's support only.
-      for (std::uint64_t bits = row.support; bits != 0; bits &= bits - 1)
-        y[static_cast<size_t>(std::countr_zero(bits))] = 0.0;
-      if (is_joint_row(row)) {
-        const Body& b = model.bodies[static_cast<size_t>(row.limit_body)];
-        for (int k = 0; k < b.dof_num; ++k)
-          y[static_cast<size_t>(b.dof_adr) + static_cast<size_t>(k)] = row.limit_coef(k);
-      } else {
-        for (const auto* side : {&row.a, &row.b}) {
-          if (side->kind != ContactSide::Kind::body) continue;
-          const Vec6& u = side == &row.a ? row.ua : row.ub;
-          for (std::uint64_t bits = model.body_path_dofs[static_cast<size_t>(side->index)]; bits != 0;
-               bits &= bits - 1) {
-            const auto k = static_cast<size_t>(std::countr_zero(bits));
-            y[k] += u.dot(data.cdof[k]);
-          }
-        }
-      }
-      for (std::uint64_t bits = row.support; bits != 0; bits &= bits - 1) {
-        const auto k = static_cast<size_t>(std::countr_zero(bits));
-        v_pre += y[k] * data.qvel[k];
-        v_free += y[k] * data.qvel_free[k];
-      }
-      // Prescribed dofs do not yield; the solve stays on the support (L has the tree's sparsity).
-      for (std::uint64_t bits = row.support; bits != 0; bits &= bits - 1) {
-        const auto k = static_cast<size_t>(std::countr_zero(bits));
-        if (static_cast<int>(k) < first) y[k] = 0.0;
-      }
-      if (row.support != path.support &&
-          !ltdl::gather_path(data.factor, nv, model.dof_parent, first, row.support, path)) {
-        ltdl::solve_lt_on(data.factor, nv, model.dof_parent, first, row.support, std::span<double>(y).first(unv));
-      } else {
-        ltdl::solve_lt_path(path, std::span<double>(y).first(unv));
-      }
-      auto at = static_cast<size_t>(row.jac_offset);
-      for (std::uint64_t bits = row.support; bits != 0; bits &= bits - 1, ++at) {
-        const auto k = static_cast<size_t>(std::countr_zero(bits));
-        const double yk = static_cast<int>(k) >= first ? y[k] * inv_sqrt_d[k] : 0.0;
-        data.jac_values[at] = yk;
-        data.jac_dofs[at] = static_cast<std::uint8_t>(k);
-        diag += yk * yk;
-      }
+    const int body = single_body(row);
+    if (body >= 0 && axes.body != body) load_axes(model, data, body, inv_sqrt_d, axes);
+    if (body >= 0 && axes.ok) {
+      const Vec6& u = row.a.kind == ContactSide::Kind::body ? row.ua : row.ub;
+      v_pre += u.dot(axes.v_pre);
+      v_free += u.dot(axes.v_free);
+      diag += axes.whiten(u, &data.jac_values[static_cast<size_t>(row.jac_offset)],
+                          &data.jac_dofs[static_cast<size_t>(row.jac_offset)]);
+    } else if (row.jac_size > 0) {
+      diag += whiten_row(model, data, row, inv_sqrt_d, path, v_pre, v_free);
     }
     row.ia.setZero();
     row.ib.setZero();
