@@ -14,6 +14,10 @@ using namespace tonus::sim;
 
 namespace {
 
+std::size_t at(int r, int c, int n) {
+  return static_cast<std::size_t>(r) * static_cast<std::size_t>(n) + static_cast<std::size_t>(c);
+}
+
 // A tree of dofs: 0-5 a chain (a free root), two branches from 5 (6-8 and
 // 9-11), and 12-13 hanging from 8.
 constexpr int kN = 14;
@@ -46,12 +50,12 @@ TEST_CASE("ltdl: the factor of L^T D L gives back L and D; the path solve matche
   const Eigen::MatrixXd h = l.transpose() * d.asDiagonal() * l;
   std::vector<double> f(static_cast<std::size_t>(kN * kN));
   for (int r = 0; r < kN; ++r)
-    for (int c = 0; c < kN; ++c) f[static_cast<std::size_t>(r * kN + c)] = h(r, c);
+    for (int c = 0; c < kN; ++c) f[at(r, c, kN)] = h(r, c);
   REQUIRE(ltdl::factor(f, kN, kParent, 0));
   for (int k = 0; k < kN; ++k) {
-    CHECK(f[static_cast<std::size_t>(k * kN + k)] == doctest::Approx(d(k)).epsilon(1e-12));
+    CHECK(f[at(k, k, kN)] == doctest::Approx(d(k)).epsilon(1e-12));
     for (int i = 0; i < k; ++i)
-      if (ancestor(i, k)) CHECK(f[static_cast<std::size_t>(k * kN + i)] == doctest::Approx(l(k, i)).epsilon(1e-10));
+      if (ancestor(i, k)) CHECK(f[at(k, i, kN)] == doctest::Approx(l(k, i)).epsilon(1e-10));
   }
 
   for (const int first : {0, 6}) {  // all dofs, then the root's prescribed
@@ -80,7 +84,7 @@ TEST_CASE("ltdl: the factor of L^T D L gives back L and D; the path solve matche
 
 TEST_CASE("ltdl: a support that branches is not a path") {
   std::vector<double> f(static_cast<std::size_t>(kN * kN), 0.0);
-  for (int k = 0; k < kN; ++k) f[static_cast<std::size_t>(k * kN + k)] = 1.0;
+  for (int k = 0; k < kN; ++k) f[at(k, k, kN)] = 1.0;
   ltdl::PathFactor p;
   CHECK_FALSE(ltdl::gather_path(f, kN, kParent, 0, path_of(8) | path_of(11), p));
   CHECK(p.support == 0);
