@@ -37,7 +37,7 @@ std::uint64_t path_of(int k) {
 
 }  // namespace
 
-TEST_CASE("ltdl: the factor of L^T D L gives back L and D; the path solve matches the walking one bit for bit") {
+TEST_CASE("ltdl: the factor of L^T D L gives back L and D, the path solve matches the walking one bit for bit") {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Eigen::MatrixXd l = Eigen::MatrixXd::Identity(kN, kN);
