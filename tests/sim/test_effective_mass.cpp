@@ -62,7 +62,7 @@ double worst_relative_error(const Model& model, const Data& data) {
           j(rows, k - first) += u.dot(data.cdof[static_cast<std::size_t>(k)]);
     }
     for (int e = 0; e < row.jac_size; ++e) {
-      const auto at = static_cast<std::size_t>(row.jac_offset + e);
+      const std::size_t at = static_cast<std::size_t>(row.jac_offset) + static_cast<std::size_t>(e);
       y(rows, data.jac_dofs[at]) = data.jac_values[at];
     }
     ++rows;
