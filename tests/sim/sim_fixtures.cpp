@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <fstream>
 
+#include "tonus/sim/objects.hpp"
+
 namespace tonus::sim::test {
 
 std::unique_ptr<Model> humanoid(const Features& features, Integrator integrator, const HumanoidSpec& spec) {
@@ -17,6 +19,15 @@ std::unique_ptr<Model> humanoid(const Features& features, Integrator integrator,
   BuildResult r = mb.build();
   REQUIRE_MESSAGE(r, r.error);
   return std::move(r.model);
+}
+
+bool add_cube_on_right_hand(const Model& model, Data& data) {
+  const std::size_t hand = index(Bone::RightHand);
+  ObjectSpec cube;
+  cube.shape = Shape::box(Vec3::Constant(0.04));
+  cube.mass_kg = 1.0;
+  cube.pos = data.xgeom[hand].pos + Vec3(0, 0, model.geoms[hand].shape.half_extents_m.z() + 0.041);
+  return add_object(data, cube).handle.valid();
 }
 
 Mujoco::Mujoco(const std::string& xml) {

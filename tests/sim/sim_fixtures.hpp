@@ -19,6 +19,10 @@ namespace tonus::sim::test {
 std::unique_ptr<Model> humanoid(const Features& features, Integrator integrator = Integrator::euler,
                                 const HumanoidSpec& spec = {});
 
+// Adds a 1 kg, 8 cm cube resting 1 mm above the right hand (at the current
+// kinematics); false when the scene has no room.
+bool add_cube_on_right_hand(const Model& model, Data& data);
+
 // A MuJoCo model and data, loaded from an MJCF string.
 class Mujoco {
  public:

@@ -140,12 +140,7 @@ TEST_CASE("a kinematic root absorbs the weight it carries: m g, the moment of th
   CHECK((data->root_wrench_torque - (-arm.cross(weight))).norm() < 1e-3 * m * kG * 0.1 + 1e-3);
 
   // A 1 kg cube resting on the right hand: one more newton-kilogram of weight, at the hand.
-  const Pose& hand = data->xgeom[index(Bone::RightHand)];
-  ObjectSpec cube;
-  cube.shape = Shape::box(Vec3::Constant(0.04));
-  cube.mass_kg = 1.0;
-  cube.pos = hand.pos + Vec3(0, 0, model->geoms[index(Bone::RightHand)].shape.half_extents_m.z() + 0.041);
-  REQUIRE(add_object(*data, cube).handle.valid());
+  REQUIRE(test::add_cube_on_right_hand(*model, *data));
   for (int s = 0; s < 2000; ++s) REQUIRE(step(*model, *data, in) != StepStatus::diverged);
   CHECK(data->ncon > 0);
   CHECK(data->root_wrench_force.z() == doctest::Approx((m + 1.0) * kG).epsilon(2e-3));

@@ -9,7 +9,6 @@
 
 #include "sim_fixtures.hpp"
 #include "stages.hpp"
-#include "tonus/sim/objects.hpp"
 
 using namespace tonus::sim;
 
@@ -86,12 +85,7 @@ TEST_CASE("effective mass: the whitened contact rows give J M~^-1 J^T of a dense
     if (mode == RootMode::kinematic) in.root_pos.z() -= 0.002;  // the feet on the floor
     // A cube on the right hand: rows on the arm's path beside the feet's.
     forward_kinematics(*model, *data);
-    const Pose& hand = data->xgeom[index(Bone::RightHand)];
-    ObjectSpec cube;
-    cube.shape = Shape::box(Vec3::Constant(0.04));
-    cube.mass_kg = 1.0;
-    cube.pos = hand.pos + Vec3(0, 0, model->geoms[index(Bone::RightHand)].shape.half_extents_m.z() + 0.041);
-    REQUIRE(add_object(*data, cube).handle.valid());
+    REQUIRE(test::add_cube_on_right_hand(*model, *data));
     for (int s = 0; s < 60; ++s) REQUIRE(step(*model, *data, in) != StepStatus::diverged);
     assemble_now(*model, *data, in);
     const double error = worst_relative_error(*model, *data);
