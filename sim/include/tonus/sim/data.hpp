@@ -201,7 +201,7 @@ struct Data {
     double target = 0.0;             // desired row velocity (gap closing, restitution, Baumgarte)
     double lambda = 0.0;             // impulse, N*s or N*m*s
     double cfm = 0.0;                // compliance of a drive row: 1 / (dt (Kd + dt Kp))
-    double bound = 0.0;              // a drive row group's impulse limit (norm over the group)
+    double bound = 0.0;              // impulse cap (a drive group: on its norm; see row_ops.hpp)
     double diag = 0.0;               // effective inverse mass along the row: (J M~^-1 J^T)_rr
     double v0 = 0.0;                 // row velocity at the unconstrained end-of-step velocities
     double pre = 0.0;                // row velocity at the start of the step
