@@ -22,15 +22,18 @@ std::string socket_path(const char* what) {
       .string();
 }
 
-std::vector<std::string> band_args(const std::string& path, const char* seconds) {
-  return {"--synthetic", "rest", "--seconds", seconds, "--quiet", "--hid-socket", path};
+std::vector<std::string> band_args(const std::string& path, const char* seconds, const std::string& storage) {
+  return {"--synthetic", "rest", "--seconds", seconds, "--quiet", "--hid-socket", path, "--storage", storage};
 }
 
 }  // namespace
 
 TEST_CASE("unplug/replug: tonus-band-sim killed and restarted, the link resumes by itself") {
   const std::string path = socket_path("replug");
-  auto sim = std::make_unique<test::SimProcess>(band_args(path, "20"));
+  // The band's flash outlives the unplug: its boot count, and so its epoch, moves on.
+  const std::string storage = socket_path("replug-flash") + ".bin";
+  std::filesystem::remove(storage);
+  auto sim = std::make_unique<test::SimProcess>(band_args(path, "20", storage));
   REQUIRE(sim->started());
   host::ReconnectPolicy policy;
   policy.first_retry = 20ms;
@@ -60,7 +63,7 @@ TEST_CASE("unplug/replug: tonus-band-sim killed and restarted, the link resumes 
       killed_at = std::chrono::steady_clock::now();
     }
     if (killed && !restarted_band && std::chrono::steady_clock::now() - killed_at > 300ms) {
-      sim = std::make_unique<test::SimProcess>(band_args(path, "20"));  // plugged in again
+      sim = std::make_unique<test::SimProcess>(band_args(path, "20", storage));  // plugged in again
       REQUIRE(sim->started());
       restarted_band = true;
     }
@@ -78,6 +81,7 @@ TEST_CASE("unplug/replug: tonus-band-sim killed and restarted, the link resumes 
   CHECK(s.stale + s.duplicates == 0);
   CHECK(s.decode_errors == 0);
   std::filesystem::remove(path);
+  std::filesystem::remove(storage);
 }
 
 TEST_CASE("the band reboots on `reset` after 500 reports: every report of its next boot is kept (defect 8)") {

@@ -160,7 +160,7 @@ int run(const Options& opt) {
   sim::FlashStorage storage(opt.storage);
   sim::SimLed led;
   sim::SimWatchdog watchdog;
-  sim::SimSystem system;
+  sim::SimSystem system(!opt.storage.empty());  // with storage, epochs follow the persisted boot count
 
   sim::SeqpacketEndpoint hid_ep, can_ep;
   std::unique_ptr<sim::SeqpacketHid> hid;

@@ -143,13 +143,19 @@ class SimWatchdog final : public hal::Watchdog {
 class SimSystem final : public hal::SystemControl {
  public:
   SimSystem();  // a per-process boot epoch, never 0
+  // retained: the band's boot count persists (a storage file), so the board
+  // says 0 and the device's own boot count sets the epoch; a random per-process
+  // epoch repeats the previous run's once in 255 runs.
+  explicit SimSystem(bool retained) : SimSystem() {
+    if (retained) epoch_ = 0;
+  }
   void reset() override { requested_ = true; }
   // The reboot the band would do; the next boot gets the next epoch.
   bool take_reset() {
     const bool r = requested_;
     requested_ = false;
     if (r) {
-      epoch_ = static_cast<std::uint8_t>(epoch_ % 255U + 1U);
+      if (epoch_ != 0) epoch_ = static_cast<std::uint8_t>(epoch_ % 255U + 1U);
       cause_ = proto::ResetCause::software;
     }
     return r;
