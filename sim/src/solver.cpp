@@ -237,7 +237,12 @@ void momentum(Data& data, int begin, int end, double& gg_prev, bool& have_dir) {
       data.solve_dir[r] = g;
       continue;
     }
-    const double step = beta * data.solve_dir[r];
+    // A row the sweep holds at zero gets no momentum: pushed below zero, the
+    // next sweep clips it back by as much, the change stays the same, beta
+    // stays 1, and the pair cycles forever (a toe resting on the floor did,
+    // for hundreds of steps, at 1.6e-6 m/s).
+    const bool at_zero = (row.kind == Row::Kind::normal || row.kind == Row::Kind::limit) && row.lambda <= 0.0;
+    const double step = at_zero ? 0.0 : beta * data.solve_dir[r];
     if (step != 0.0) {
       apply_row_impulse(data, row, step);
       row.lambda += step;
@@ -334,85 +339,104 @@ void apply_subspace(Data& data, size_t m, double sign) {
   }
 }
 
+// (J M~^-1 J^T + compliance)_ik of two rows, through their packed whitened
+// rows; `dense` holds row i's scattered over the dofs.
+double subspace_entry(const Data& data, const Row& ri, const Row& rk, const std::array<double, kMaxDofs>& dense,
+                      int shared) {
+  const auto oi = static_cast<size_t>(std::max(ri.jac_offset, 0));
+  const auto ok = static_cast<size_t>(std::max(rk.jac_offset, 0));
+  double v = 0.0;
+  if (shared >= 0) {
+    // The shared dofs lead both packed rows: a contiguous dot product.
+    v = dot(&data.jac_values[ok], &data.jac_values[oi], static_cast<size_t>(shared));
+  } else {
+    for (size_t j = 0; j < static_cast<size_t>(rk.jac_size); ++j)
+      v += data.jac_values[ok + j] * dense[data.jac_dofs[ok + j]];
+  }
+  if (ri.inv_mass_a > 0.0 || ri.inv_mass_b > 0.0) v += object_coupling(ri, rk);
+  return v;
+}
+
+// The body a contact with the ground acts on, else -1. All its rows' whitened
+// Jacobians lie in the span of the body's six whitened axes (constraints.cpp),
+// so no more of them than that span's dimension are independent.
+int grounded_body(const Row& row) {
+  if (is_joint_row(row)) return -1;
+  if (row.a.kind == ContactSide::Kind::body && row.b.kind == ContactSide::Kind::ground) return row.a.index;
+  if (row.b.kind == ContactSide::Kind::body && row.a.kind == ContactSide::Kind::ground) return row.b.index;
+  return -1;
+}
+
 // Returns false when there was nothing to do or no room (the island keeps
 // sweeping). Leaves the step in subspace_rhs for its first m rows.
+//
+// The factorisation is up-looking: each active row in turn is dotted with
+// the rows kept so far, a forward solve gives its row of L, and a pivot that
+// vanishes marks a row that depends on the kept ones. Sixteen points under
+// two feet are three times the rows a rigid foot has dofs for; a dependent
+// row is left out of the system before it costs a row of the matrix, so the
+// work follows the kept rows (at most the island's dofs), not the active ones.
+// A body on the ground whose kept rows already span its whitened axes needs
+// no test at all. A row left out keeps its impulse, so the others meet their
+// targets exactly and nothing is amplified.
 bool subspace_solve(Data& data, int begin, int end, size_t& m_out) {
-  int m = 0;
+  constexpr size_t kStride = kSubspaceRows;
+  double* l = data.subspace_matrix.data();  // row i of L at l + i * kStride
+  double* b = data.subspace_rhs.data();
+  std::array<double, kMaxDofs> dense{};
+  std::array<std::uint8_t, kMaxBodies> kept_on_body{};
+  const auto first = static_cast<unsigned>(data.first_active_dof);
+  const std::uint64_t free_dofs = first >= 64 ? 0 : ~((std::uint64_t{1} << first) - 1);  // prescribed dofs span nothing
+  size_t m = 0;
   for (int p = begin; p < end; ++p) {
     const auto r = static_cast<size_t>(data.island_rows[static_cast<size_t>(p)]);
     if (!is_active(data, r)) continue;
-    if (m == static_cast<int>(kSubspaceRows)) return false;
-    data.subspace_rows[static_cast<size_t>(m++)] = static_cast<int>(r);
-  }
-  if (m == 0) return false;
-  const auto um = static_cast<size_t>(m);
-  m_out = um;
-  double* a = data.subspace_matrix.data();
-  double* b = data.subspace_rhs.data();
-  std::array<double, kMaxDofs> dense{};
-  for (size_t i = 0; i < um; ++i) {
-    const Row& ri = data.rows[static_cast<size_t>(data.subspace_rows[i])];
+    const Row& ri = data.rows[r];
+    const int body = grounded_body(ri);
+    const auto span = static_cast<std::uint8_t>(std::min(6, std::popcount(ri.support & free_dofs)));
+    if (body >= 0 && kept_on_body[static_cast<size_t>(body)] >= span) continue;  // depends on the kept rows
+    if (m == kSubspaceRows) return false;
     const auto oi = static_cast<size_t>(std::max(ri.jac_offset, 0));
     for (size_t j = 0; j < static_cast<size_t>(ri.jac_size); ++j)
       dense[data.jac_dofs[oi + j]] = data.jac_values[oi + j];
+    double* li = l + m * kStride;
     std::uint64_t seen_support = 0;
     int seen_shared = 0;
-    for (size_t k = 0; k <= i; ++k) {
+    double norm2 = 0.0;
+    for (size_t k = 0; k < m; ++k) {
       const Row& rk = data.rows[static_cast<size_t>(data.subspace_rows[k])];
-      const auto ok = static_cast<size_t>(std::max(rk.jac_offset, 0));
-      double v = 0.0;
       if (rk.support != seen_support) {  // rows of one body come together and share their support
         seen_support = rk.support;
         seen_shared = shared_prefix(ri.support, rk.support);
       }
-      if (seen_shared >= 0) {
-        // The shared dofs lead both packed rows: a contiguous dot product.
-        v = dot(&data.jac_values[ok], &data.jac_values[oi], static_cast<size_t>(seen_shared));
-      } else {
-        for (size_t j = 0; j < static_cast<size_t>(rk.jac_size); ++j)
-          v += data.jac_values[ok + j] * dense[data.jac_dofs[ok + j]];
-      }
-      if (ri.inv_mass_a > 0.0 || ri.inv_mass_b > 0.0) v += object_coupling(ri, rk);
-      a[i * um + k] = v;
+      const double a = subspace_entry(data, ri, rk, dense, seen_shared);
+      const double lk = (a - dot(li, l + k * kStride, k)) / l[k * kStride + k];
+      li[k] = lk;
+      norm2 += lk * lk;
     }
+    const double own = subspace_entry(data, ri, ri, dense, shared_prefix(ri.support, ri.support)) + ri.cfm;
     for (size_t j = 0; j < static_cast<size_t>(ri.jac_size); ++j) dense[data.jac_dofs[oi + j]] = 0.0;
-    a[i * um + i] += ri.cfm;
+    const double d = own - norm2;
+    if (!(d > kDependentPivot * own) || !(own > 0.0)) continue;  // depends on the kept rows
+    li[m] = std::sqrt(d);
     const double target = ri.kind == Row::Kind::friction1 || ri.kind == Row::Kind::friction2 ? 0.0 : ri.target;
-    b[i] = target - row_velocity(data, ri) - ri.cfm * ri.lambda;
+    b[m] = target - row_velocity(data, ri) - ri.cfm * ri.lambda;
+    data.subspace_rows[m++] = static_cast<int>(r);
+    if (body >= 0) ++kept_on_body[static_cast<size_t>(body)];
   }
-  // Cholesky (lower) in place, dropping rows that depend on earlier ones:
-  // four points under a face are one row too many for a rigid body, and a
-  // pivot that vanishes marks such a row. It keeps no impulse change, so the
-  // others meet their targets exactly and nothing is amplified.
-  std::array<bool, kSubspaceRows> dependent{};
-  for (size_t j = 0; j < um; ++j) {
-    const double own = a[j * um + j];
-    double d = own - dot(&a[j * um], &a[j * um], j);
-    if (!(d > kDependentPivot * own) || !(own > 0.0)) {
-      dependent[j] = true;
-      a[j * um + j] = 1.0;
-      for (size_t i = j + 1; i < um; ++i) a[i * um + j] = 0.0;
-      continue;
-    }
-    d = std::sqrt(d);
-    a[j * um + j] = d;
-    for (size_t i = j + 1; i < um; ++i) {
-      a[i * um + j] = (a[i * um + j] - dot(&a[i * um], &a[j * um], j)) / d;
-    }
+  if (m == 0) return false;
+  m_out = m;
+  // L L^T x = b: forward, then backward by columns (rows of L are contiguous).
+  for (size_t i = 0; i < m; ++i) b[i] = (b[i] - dot(l + i * kStride, b, i)) / l[i * kStride + i];
+  for (size_t i = m; i-- > 0;) {
+    const double* li = l + i * kStride;
+    b[i] /= li[i];
+    for (size_t k = 0; k < i; ++k) b[k] -= li[k] * b[i];
   }
-  for (size_t i = 0; i < um; ++i) {
-    const double v = b[i] - dot(&a[i * um], b, i);
-    b[i] = dependent[i] ? 0.0 : v / a[i * um + i];
-  }
-  for (size_t i = um; i-- > 0;) {
-    double v = b[i];
-    for (size_t k = i + 1; k < um; ++k) v -= a[k * um + i] * b[k];
-    b[i] = dependent[i] ? 0.0 : v / a[i * um + i];
-  }
-  for (size_t i = 0; i < um; ++i) {
+  for (size_t i = 0; i < m; ++i) {
     if (!std::isfinite(b[i])) return false;
   }
-  apply_subspace(data, um, 1.0);
+  apply_subspace(data, m, 1.0);
   return true;
 }
 
