@@ -38,8 +38,13 @@ TEST_CASE("viewer json: a scene message has every field, in the scene's order") 
   CHECK(s["protocol"] == tv::kProtocolVersion);
   CHECK(s["mode"] == "live");
   REQUIRE(s["bones"].size() == 3);
-  CHECK(s["bones"][0] == json{{"name", "Hips"}, {"parent", -1}, {"group", 1}});
-  CHECK(s["bones"][2] == json{{"name", "RightHand"}, {"parent", 1}, {"group", 0}});
+  CHECK(
+      s["bones"][0] ==
+      json{{"name", "Hips"}, {"parent", -1}, {"group", 1}, {"rest", json::array({0.0, 0.0, 0.9, 0.0, 0.0, 0.0, 1.0})}});
+  CHECK(s["bones"][2] == json{{"name", "RightHand"},
+                              {"parent", 1},
+                              {"group", 0},
+                              {"rest", json::array({0.0, -0.7, 1.4, 0.0, 0.0, 0.707107, 0.707107})}});
   REQUIRE(s["geoms"].size() == 3);
   const json& capsule = s["geoms"][0];
   CHECK(capsule["bone"] == 0);
@@ -57,7 +62,12 @@ TEST_CASE("viewer json: a scene message has every field, in the scene's order") 
   CHECK(s["gift_bones"] == json::array({"Chest", "RightHand"}));
   CHECK(s["ground_z_m"] == 0.0);
   CHECK(s["rate_hz"] == 1000.0);
-  CHECK(s.size() == 9);  // nothing else
+  CHECK(s["vrm"].is_null());  // no avatar
+  CHECK(s.size() == 10);      // nothing else
+
+  tv::Scene with = tv::testing::small_scene();
+  with.vrm = tv::SceneVrm{"/avatar.vrm", "alice.vrm", 12345};
+  CHECK(json::parse(tv::to_json(with))["vrm"] == json{{"url", "/avatar.vrm"}, {"name", "alice.vrm"}, {"bytes", 12345}});
 }
 
 TEST_CASE("viewer json: a frame message has every field, poses as [px, py, pz, qx, qy, qz, qw]") {

@@ -21,6 +21,7 @@
 
 #include "tonus/host/viewer/server.hpp"
 #include "viewer_fixtures.hpp"
+#include "vrm_files.hpp"
 
 namespace tv = tonus::viewer;
 namespace tt = tonus::viewer::testing;
@@ -378,6 +379,67 @@ TEST_CASE("viewer server: three.js is served from node_modules under /vendor/thr
   CHECK(no_three.status == 404);
   CHECK(no_three.body.find("run scripts/install-deps.sh") != std::string::npos);
   std::filesystem::remove_all(bare);
+}
+
+TEST_CASE("viewer server: the VRM avatar is served at /avatar.vrm, its file only, and the scene announces it") {
+  tt::TempDir dir;
+  const std::string bytes = tt::glb_bytes(R"({"asset":{"version":"2.0"}})");
+  const std::filesystem::path file = dir.path / "alice.vrm";
+  tt::write_file(file, bytes);
+  tv::ViewerConfig config = loopback_config();
+  config.vrm_file = file.string();
+  Running s(config);
+
+  tt::WsClient client(s.port());
+  REQUIRE(client.wait_open());
+  const auto scene = client.wait_message([](const json& m) { return is_type(m, "scene"); });
+  REQUIRE(scene);
+  CHECK((*scene)["vrm"] == json{{"url", "/avatar.vrm"}, {"name", "alice.vrm"}, {"bytes", bytes.size()}});
+
+  for (const char* target : {"/avatar.vrm", "/avatar.vrm?file=../../etc/passwd", "/%61vatar.vrm"}) {
+    CAPTURE(target);
+    const tt::HttpReply r = tt::http_get(s.port(), target);
+    CHECK(r.status == 200);
+    CHECK(r.header("content-type") == "model/gltf-binary");
+    CHECK(r.body == bytes);
+  }
+  const tt::HttpReply head = tt::http_get(s.port(), "/avatar.vrm", "HEAD");
+  CHECK(head.status == 200);
+  CHECK(head.body.empty());
+  CHECK(head.header("content-length") == std::to_string(bytes.size()));
+  // No other URL reaches the file, nor any other .vrm.
+  for (const char* target : {"/alice.vrm", "/avatar.vrm/alice.vrm", "/vendor/avatar.vrm", "/avatar.VRM"}) {
+    CAPTURE(target);
+    const tt::HttpReply r = tt::http_get(s.port(), target);
+    CHECK(r.status == 404);
+    CHECK(r.body != bytes);
+  }
+  CHECK(tt::http_get(s.port(), "/avatar.vrm", "POST").status == 405);
+
+  // Damaged or gone after the start: refused with the reason, never half served.
+  tt::write_file(file, "not a glTF at all");
+  const tt::HttpReply damaged = tt::http_get(s.port(), "/avatar.vrm");
+  CHECK(damaged.status == 500);
+  CHECK(damaged.body.find("alice.vrm is not usable now: not a glTF binary") != std::string::npos);
+  std::filesystem::remove(file);
+  CHECK(tt::http_get(s.port(), "/avatar.vrm").body.find("no such file") != std::string::npos);
+}
+
+TEST_CASE("viewer server: without a VRM file, /avatar.vrm is a 404 even when the web root holds one") {
+  tt::TempDir dir;
+  tt::write_file(dir.path / "web" / "index.html", "<!doctype html><title>t</title>");
+  tt::write_file(dir.path / "web" / "avatar.vrm", tt::glb_bytes("{}"));
+  tv::ViewerConfig config = loopback_config();
+  config.web_root = (dir.path / "web").string();
+  Running s(config);
+  const tt::HttpReply r = tt::http_get(s.port(), "/avatar.vrm");
+  CHECK(r.status == 404);
+  CHECK(r.body.find("no VRM avatar: start tonusd with --vrm FILE") != std::string::npos);
+  tt::WsClient client(s.port());
+  REQUIRE(client.wait_open());
+  const auto scene = client.wait_message([](const json& m) { return is_type(m, "scene"); });
+  REQUIRE(scene);
+  CHECK((*scene)["vrm"].is_null());
 }
 
 TEST_CASE("viewer server: path traversal is refused and nothing outside the web root is sent") {

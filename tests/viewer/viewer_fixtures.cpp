@@ -185,7 +185,9 @@ std::string read_raw(int fd, std::chrono::milliseconds timeout) {
 Scene small_scene() {
   Scene s;
   s.mode = "live";
-  s.bones = {{"Hips", -1, 1}, {"Chest", 0, 1}, {"RightHand", 1, 0}};
+  s.bones = {{"Hips", -1, 1, {{0.0, 0.0, 0.9}, {0.0, 0.0, 0.0, 1.0}}},
+             {"Chest", 0, 1, {{0.0, 0.0, 1.2}, {0.0, 0.0, 0.0, 1.0}}},
+             {"RightHand", 1, 0, {{0.0, -0.7, 1.4}, {0.0, 0.0, std::sqrt(0.5), std::sqrt(0.5)}}}};
   GeomInfo capsule;
   capsule.bone = 0;
   capsule.shape = "capsule";

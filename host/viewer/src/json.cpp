@@ -210,7 +210,9 @@ ClientMessage parse_playback(const json& doc) {
 
 std::string to_json(const Scene& scene) {
   json bones = json::array();
-  for (const BoneInfo& b : scene.bones) bones.push_back({{"name", b.name}, {"parent", b.parent}, {"group", b.group}});
+  for (const BoneInfo& b : scene.bones) {
+    bones.push_back({{"name", b.name}, {"parent", b.parent}, {"group", b.group}, {"rest", pose(b.rest)}});
+  }
   json geoms = json::array();
   for (const GeomInfo& g : scene.geoms) {
     geoms.push_back({{"bone", g.bone},
@@ -221,15 +223,18 @@ std::string to_json(const Scene& scene) {
                      {"pos", numbers(g.pos, kMetres)},
                      {"quat", numbers(g.quat, kQuat)}});
   }
-  const json doc = {{"type", "scene"},
-                    {"protocol", kProtocolVersion},
-                    {"mode", scene.mode},
-                    {"bones", std::move(bones)},
-                    {"geoms", std::move(geoms)},
-                    {"groups", scene.groups},
-                    {"gift_bones", scene.gift_bones},
-                    {"ground_z_m", number(scene.ground_z_m, kMetres)},
-                    {"rate_hz", number(scene.rate_hz, kUnrounded)}};
+  const json doc = {
+      {"type", "scene"},
+      {"protocol", kProtocolVersion},
+      {"mode", scene.mode},
+      {"bones", std::move(bones)},
+      {"geoms", std::move(geoms)},
+      {"groups", scene.groups},
+      {"gift_bones", scene.gift_bones},
+      {"ground_z_m", number(scene.ground_z_m, kMetres)},
+      {"rate_hz", number(scene.rate_hz, kUnrounded)},
+      {"vrm", scene.vrm ? json{{"url", scene.vrm->url}, {"name", scene.vrm->name}, {"bytes", scene.vrm->bytes}}
+                        : json(nullptr)}};
   return dump(doc);
 }
 

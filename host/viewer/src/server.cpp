@@ -74,14 +74,14 @@ std::string host_name(std::string_view host) {
   return std::string(host.substr(0, host.rfind(':')));
 }
 
-std::string read_file(const std::filesystem::path& path, std::string& error) {
+std::string read_file(const std::filesystem::path& path, std::string& error, std::uintmax_t max_bytes = kMaxFileBytes) {
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
   if (ec) {
     error = "cannot read " + path.filename().string();
     return {};
   }
-  if (size > kMaxFileBytes) {
+  if (size > max_bytes) {
     error = path.filename().string() + " is too large to serve";
     return {};
   }
@@ -533,6 +533,10 @@ struct ViewerServer::Impl {
       text(websocketpp::http::status_code::upgrade_required, "this is the viewer's WebSocket: open / in a browser");
       return;
     }
+    if (percent_decode(target.substr(0, target.find_first_of("?#"))) == std::string(kVrmUrl)) {
+      serve_vrm(con, method);
+      return;
+    }
     const StaticTarget file = resolve_static(config.web_root, target);
     if (file.status != 200) {
       text(static_cast<websocketpp::http::status_code::value>(file.status), file.error);
@@ -546,6 +550,40 @@ struct ViewerServer::Impl {
     }
     con->set_status(websocketpp::http::status_code::ok);
     con->replace_header("Content-Type", std::string(mime_type(file.file)));
+    if (method == "HEAD") {
+      con->set_body("");
+      con->replace_header("Content-Length", std::to_string(body.size()));
+    } else {
+      con->set_body(body);
+    }
+  }
+
+  // The configured avatar, and only it: the request's path picks no file.
+  void serve_vrm(const WsServer::connection_ptr& con, const std::string& method) const {
+    auto text = [&](websocketpp::http::status_code::value status, const std::string& body) {
+      con->set_status(status);
+      con->replace_header("Content-Type", "text/plain; charset=utf-8");
+      con->set_body(body + "\n");
+    };
+    if (config.vrm_file.empty()) {
+      text(websocketpp::http::status_code::not_found, "no VRM avatar: start tonusd with --vrm FILE");
+      return;
+    }
+    const std::filesystem::path path(config.vrm_file);
+    const VrmFileInfo info = check_vrm_file(path);
+    if (!info.error.empty()) {
+      text(websocketpp::http::status_code::internal_server_error,
+           "the VRM file " + path.filename().string() + " is not usable now: " + info.error);
+      return;
+    }
+    std::string error;
+    const std::string body = read_file(path, error, kMaxVrmBytes);
+    if (!error.empty()) {
+      text(websocketpp::http::status_code::internal_server_error, error);
+      return;
+    }
+    con->set_status(websocketpp::http::status_code::ok);
+    con->replace_header("Content-Type", "model/gltf-binary");  // whatever the file is named
     if (method == "HEAD") {
       con->set_body("");
       con->replace_header("Content-Length", std::to_string(body.size()));
@@ -588,7 +626,15 @@ void ViewerServer::set_playback_handler(PlaybackHandler handler) {
 }
 
 void ViewerServer::set_scene(const Scene& scene) {
-  auto message = std::make_shared<const std::string>(to_json(scene));
+  Scene announced = scene;
+  announced.vrm.reset();
+  if (!impl_->config.vrm_file.empty()) {
+    const std::filesystem::path path(impl_->config.vrm_file);
+    const VrmFileInfo info = check_vrm_file(path);
+    // Announced even when unusable now: the page then shows why, from the reply to its request.
+    announced.vrm = SceneVrm{std::string(kVrmUrl), path.filename().string(), info.bytes};
+  }
+  auto message = std::make_shared<const std::string>(to_json(announced));
   Impl& d = *impl_;
   const std::lock_guard<std::mutex> s(d.shared);
   if (d.scene && *d.scene == *message) return;  // unchanged: nothing to re-send

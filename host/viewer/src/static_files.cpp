@@ -41,15 +41,16 @@ bool is_within(const fs::path& path, const fs::path& base) {
 }
 
 struct Mount {
-  std::string_view prefix;  // URL prefix, ends with '/'
-  std::string_view folder;  // under the web root
-  bool three = false;       // part of three.js (missing: the install hint)
+  std::string_view prefix;   // URL prefix, ends with '/'
+  std::string_view folder;   // under the web root
+  std::string_view missing;  // the install hint when the folder is missing
 };
 
 // Longest prefix first.
-constexpr std::array<Mount, 2> kMounts{{
-    {"/vendor/three/addons/", "node_modules/three/examples/jsm", true},
-    {"/vendor/three/", "node_modules/three/build", true},
+constexpr std::array<Mount, 3> kMounts{{
+    {"/vendor/three/addons/", "node_modules/three/examples/jsm", kThreeMissing},
+    {"/vendor/three/", "node_modules/three/build", kThreeMissing},
+    {"/vendor/three-vrm/", "node_modules/@pixiv/three-vrm/lib", kThreeVrmMissing},
 }};
 
 }  // namespace
@@ -84,12 +85,12 @@ StaticTarget resolve_static(const fs::path& web_root, std::string_view target) {
 
   std::string_view rest = path;
   fs::path base = web_root;
-  bool three = false;
+  const Mount* mount = nullptr;
   for (const Mount& m : kMounts) {
     if (rest.substr(0, m.prefix.size()) == m.prefix) {
       rest.remove_prefix(m.prefix.size());
       base = web_root / m.folder;
-      three = m.three;
+      mount = &m;
       break;
     }
   }
@@ -112,17 +113,17 @@ StaticTarget resolve_static(const fs::path& web_root, std::string_view target) {
       }
     }
   }
-  if (!three && !segments.empty() && segments.front() == "node_modules") {
+  if (mount == nullptr && !segments.empty() && segments.front() == "node_modules") {
     return refuse(403, "node_modules is served only under /vendor/");
   }
 
   fs::path relative;
   for (std::string_view seg : segments) relative /= fs::path(std::string(seg));
-  if (segments.empty() && !three) relative = "index.html";
+  if (segments.empty() && mount == nullptr) relative = "index.html";
 
   std::error_code ec;
-  if (three && !fs::is_directory(base, ec)) {
-    return refuse(404, std::string(kThreeMissing) + " (no " + base.string() + ")");
+  if (mount != nullptr && !fs::is_directory(base, ec)) {
+    return refuse(404, std::string(mount->missing) + " (no " + base.string() + ")");
   }
   const fs::path canonical_base = fs::canonical(base, ec);
   if (ec) return refuse(404, "the web root " + base.string() + " does not exist");

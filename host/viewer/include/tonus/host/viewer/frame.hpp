@@ -18,12 +18,27 @@ using Vec2 = std::array<double, 2>;
 using Vec3 = std::array<double, 3>;
 using QuatXyzw = std::array<double, 4>;
 
+struct BonePose {
+  Vec3 pos{};  // world, the bone frame's origin
+  QuatXyzw quat{0.0, 0.0, 0.0, 1.0};
+};
+
 // --- the scene: what does not change while a connection lives ------------
 
 struct BoneInfo {
   std::string name;  // HumanBodyBones ("Hips", "LeftHand", ...)
   int parent = -1;   // index into Scene::bones, -1 for the root
   int group = -1;    // stiffness group (index into Scene::groups), -1: none
+  BonePose rest;     // the bone frame in the world at the rest pose (a T-pose): what a VRM's bones are driven from
+};
+
+// The VRM avatar the page may load (docs/viewer.md). The server fills this
+// from its ViewerConfig::vrm_file whatever the caller set: the scene says
+// there is an avatar exactly when the server serves one.
+struct SceneVrm {
+  std::string url;   // kVrmUrl
+  std::string name;  // the file's name (no folder), for the page's status line
+  std::uint64_t bytes = 0;
 };
 
 // One collision shape of a bone, in the bone's frame (a capsule's segment lies
@@ -45,15 +60,11 @@ struct Scene {
   std::vector<std::string> groups;      // stiffness group names, in the order of Frame::stiffness
   std::vector<std::string> gift_bones;  // bones a gift may target (the page's pickers)
   double ground_z_m = 0.0;
-  double rate_hz = 1000.0;  // physics rate
+  double rate_hz = 1000.0;      // physics rate
+  std::optional<SceneVrm> vrm;  // set by the server (see SceneVrm)
 };
 
 // --- a frame: one instant --------------------------------------------------
-
-struct BonePose {
-  Vec3 pos{};  // world, the bone frame's origin
-  QuatXyzw quat{0.0, 0.0, 0.0, 1.0};
-};
 
 struct ObjectFrame {
   std::uint32_t id = 0;  // the request's id

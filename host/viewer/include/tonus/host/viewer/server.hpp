@@ -43,6 +43,7 @@
 #include "tonus/host/viewer/frame.hpp"
 #include "tonus/host/viewer/json.hpp"
 #include "tonus/host/viewer/static_files.hpp"
+#include "tonus/host/viewer/vrm_file.hpp"
 
 namespace tonus::viewer {
 
@@ -54,6 +55,10 @@ struct ViewerConfig {
   int port = kDefaultPort;                                      // 0: the system picks one (port() tells)
   bool allow_remote = false;                                    // needed for any address outside 127.0.0.0/8 and ::1
   std::string web_root = default_web_root();
+  // A VRM avatar served at kVrmUrl (vrm_file.hpp) and announced in the scene;
+  // empty: none (kVrmUrl answers 404). Checked on every request: a file that
+  // stopped being a usable glTF binary is refused with the reason.
+  std::string vrm_file;
   std::size_t max_buffered_bytes = std::size_t{256} * 1024;  // per connection: frames beyond it are dropped
   std::size_t max_connections = 8;                           // WebSocket connections; more: 503
   int stall_timeout_ms = 10000;                              // a connection over max_buffered_bytes this long is closed
@@ -116,7 +121,8 @@ class ViewerServer {
 
   // Any time, from any thread (also before start()). A scene that differs
   // from the last one is sent to every open connection; each new connection
-  // gets the latest scene, then the latest frame.
+  // gets the latest scene, then the latest frame. Its `vrm` is set from
+  // vrm_file here, whatever the caller put there.
   void set_scene(const Scene& scene);
   void publish(const Frame& frame);
 

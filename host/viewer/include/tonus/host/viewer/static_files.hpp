@@ -6,6 +6,7 @@
 //   /                          -> WEB_ROOT/index.html
 //   /vendor/three/addons/X     -> WEB_ROOT/node_modules/three/examples/jsm/X
 //   /vendor/three/X            -> WEB_ROOT/node_modules/three/build/X
+//   /vendor/three-vrm/X        -> WEB_ROOT/node_modules/@pixiv/three-vrm/lib/X
 //   /X                         -> WEB_ROOT/X  (not node_modules/ itself)
 // Refused: "." and ".." segments (also percent-encoded), hidden files (a
 // segment starting with '.'), backslashes, NUL and control characters, bad
@@ -43,5 +44,7 @@ std::string_view mime_type(const std::filesystem::path& file);
 
 // The message a page shows (and a 404 carries) when three.js is missing.
 inline constexpr std::string_view kThreeMissing = "three.js is not installed: run scripts/install-deps.sh";
+// The same for three-vrm (only a page with a VRM avatar needs it).
+inline constexpr std::string_view kThreeVrmMissing = "three-vrm is not installed: run scripts/install-deps.sh";
 
 }  // namespace tonus::viewer
