@@ -38,6 +38,7 @@ struct TempRoot {
       write(root / "node_modules" / "three" / "build" / "three.module.js", "export const REVISION = '0';");
       write(root / "node_modules" / "three" / "examples" / "jsm" / "controls" / "OrbitControls.js", "export {};");
       write(root / "node_modules" / "puppeteer-core" / "package.json", "{}");
+      write(root / "node_modules" / "@pixiv" / "three-vrm" / "lib" / "three-vrm.module.js", "export {};");
     }
     fs::create_symlink(dir / "secret.txt", root / "escape.txt");
   }
@@ -68,6 +69,10 @@ TEST_CASE("viewer static files: the page, its modules and three.js under /vendor
   CHECK(t.get("/vendor/three/addons/controls/OrbitControls.js").file ==
         root / "node_modules/three/examples/jsm/controls/OrbitControls.js");
   CHECK(t.get("/%6As/main.js").file == root / "js" / "main.js");  // %6A = 'j'
+  CHECK(t.get("/vendor/three-vrm/three-vrm.module.js").file ==
+        root / "node_modules/@pixiv/three-vrm/lib/three-vrm.module.js");
+  CHECK(t.get("/vendor/three-vrm/../../three/build/three.module.js").status == 403);
+  CHECK(t.get("/node_modules/@pixiv/three-vrm/lib/three-vrm.module.js").status == 403);
 }
 
 TEST_CASE("viewer static files: missing files are 404") {
@@ -113,7 +118,7 @@ TEST_CASE("viewer static files: malformed targets are 400") {
   CHECK(t.get("/js/%5c..%5c..%5csecret.txt").status == 400);
 }
 
-TEST_CASE("viewer static files: without node_modules, three.js's paths say how to install it") {
+TEST_CASE("viewer static files: without node_modules, three.js's and three-vrm's paths say how to install them") {
   const TempRoot t(false);
   const tv::StaticTarget r = t.get("/vendor/three/three.module.js");
   CHECK(r.status == 404);
@@ -121,6 +126,9 @@ TEST_CASE("viewer static files: without node_modules, three.js's paths say how t
   CHECK(t.get("/vendor/three/addons/controls/OrbitControls.js").error.find("scripts/install-deps.sh") !=
         std::string::npos);
   CHECK(t.get("/").status == 200);  // the page itself still loads
+  const tv::StaticTarget vrm = t.get("/vendor/three-vrm/three-vrm.module.js");
+  CHECK(vrm.status == 404);
+  CHECK(vrm.error.find(std::string(tv::kThreeVrmMissing)) != std::string::npos);
 }
 
 TEST_CASE("viewer static files: MIME types") {
