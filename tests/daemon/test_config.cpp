@@ -2,7 +2,13 @@
 // and value, unknown keys refused, and the printed config reading back the same.
 #include <doctest/doctest.h>
 
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
 #include "tonus/host/daemon/config_file.hpp"
+#include "tonus/host/viewer/vrm_file.hpp"
 
 using namespace tonus::daemon;
 
@@ -95,4 +101,68 @@ TEST_CASE("config: keys read over the defaults, the printed config reads back to
   CHECK(back.band.stiffness.stale_after_s == doctest::Approx(c.band.stiffness.stale_after_s));
   CHECK(back.demo.gifts[0].at_s == 2.5);
   CHECK(back.band.sim_args == c.band.sim_args);
+}
+
+namespace {
+
+// A glTF binary with one JSON chunk, as a .vrm starts.
+std::string glb(const std::string& json) {
+  const auto le = [](std::uint32_t v) {
+    std::string out(4, '\0');
+    for (std::size_t i = 0; i < 4; ++i) out[i] = static_cast<char>((v >> (8U * i)) & 0xFFU);
+    return out;
+  };
+  std::string chunk = json;
+  while (chunk.size() % 4 != 0) chunk += ' ';
+  return "glTF" + le(2) + le(static_cast<std::uint32_t>(20 + chunk.size())) +
+         le(static_cast<std::uint32_t>(chunk.size())) + "JSON" + chunk;
+}
+
+}  // namespace
+
+TEST_CASE("config: viewer.vrm is read and printed, and its file checked only by check_files") {
+  std::string pattern = (std::filesystem::temp_directory_path() / "tonus-config-vrm-XXXXXX").string();
+  REQUIRE(mkdtemp(pattern.data()) != nullptr);
+  const std::filesystem::path dir = pattern;
+  const auto write = [&](const std::string& name, const std::string& bytes) {
+    std::ofstream(dir / name, std::ios::binary) << bytes;
+    return (dir / name).string();
+  };
+  const std::string good = write("alice.vrm", glb(R"({"asset":{"version":"2.0"}})"));
+  const std::string text = write("text.vrm", "{\"asset\":{}}");
+  const std::string big = write("big.vrm", glb("{}"));
+  std::filesystem::resize_file(big, tonus::viewer::kMaxVrmBytes + 1);  // sparse: no disk used
+
+  DaemonConfig c;
+  REQUIRE(parse_config("[viewer]\nvrm = \"" + good + "\"\n", "a.toml", c).empty());
+  CHECK(c.viewer.vrm == good);
+  CHECK(check_files(c).empty());
+  DaemonConfig back;
+  REQUIRE(parse_config(to_toml(c), "printed", back).empty());
+  CHECK(back.viewer.vrm == good);
+  CHECK(DaemonConfig{}.viewer.vrm.empty());  // no avatar by default
+  CHECK(check_files(DaemonConfig{}).empty());
+
+  // validate() looks at values only (a recording's config validates anywhere); check_files opens the file.
+  const struct {
+    std::string path;
+    std::string expect;
+  } cases[] = {
+      {"/nonexistent/alice.vrm", "viewer.vrm = \"/nonexistent/alice.vrm\": no such file"},
+      {dir.string(), "a directory"},
+      {text, "not a glTF binary"},
+      {big, "too large"},
+  };
+  for (const auto& k : cases) {
+    c.viewer.vrm = k.path;
+    INFO(k.path);
+    CHECK(validate(c).empty());
+    const std::string e = check_files(c);
+    INFO(e);
+    CHECK(e.rfind("viewer.vrm = \"" + k.path + "\": ", 0) == 0);
+    CHECK(e.find(k.expect) != std::string::npos);
+  }
+  c.viewer.enabled = false;  // no viewer, no avatar to check
+  CHECK(check_files(c).empty());
+  std::filesystem::remove_all(dir);
 }

@@ -398,6 +398,33 @@ TEST_CASE("tonusd: a bad config names the key and the value, and nothing starts"
   CHECK(test::read_file(temp_path("printed.toml")) == test::read_file(temp_path("printed2.toml")));
 }
 
+TEST_CASE("tonusd --vrm: a file that is not a usable .vrm stops tonusd before anything starts") {
+  const std::string text = write_file("avatar-text.vrm", "{\"asset\": {\"version\": \"2.0\"}}");
+  const struct {
+    std::vector<std::string> args;
+    const char* expect;
+  } cases[] = {
+      {{"--vrm", "/nonexistent/alice.vrm"}, "viewer.vrm = \"/nonexistent/alice.vrm\": no such file"},
+      {{"--vrm", text}, "not a glTF binary"},
+      {{"--config", write_file("vrm.toml", "[viewer]\nvrm = \"/nonexistent/bob.vrm\"\n")},
+       "viewer.vrm = \"/nonexistent/bob.vrm\": no such file"},
+  };
+  int k = 0;
+  for (const auto& c : cases) {
+    std::vector<std::string> args{"--no-realtime", "--seconds", "5"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    Process p(TONUSD, args, temp_path("vrm" + std::to_string(k++) + ".log"));
+    const int rc = p.wait(std::chrono::seconds(10));
+    INFO(p.output());
+    CHECK(rc == 2);
+    CHECK(p.output().find(c.expect) != std::string::npos);
+    CHECK(p.output().find("viewer: http") == std::string::npos);  // nothing was started
+  }
+  // Without the viewer the avatar is not needed, so not checked.
+  Process off(TONUSD, {"--no-viewer", "--vrm", "/nonexistent/alice.vrm", "--print-config"}, temp_path("vrm-off.toml"));
+  CHECK(off.wait(std::chrono::seconds(10)) == 0);
+}
+
 TEST_CASE("tonusd: a candump log of a band session replays as the band") {
   const std::string log = temp_path("band.candump");
   Process sim(TONUS_BAND_SIM,

@@ -9,7 +9,7 @@
 // exactly as tonusd's will: a thrown ball or a dropped cube appears in the
 // next frames, flies to its bone and falls to the ground.
 //
-//   tonus-viewer-fixture [--port N] [--seconds S] [--rate HZ] [--playback] [--web-root DIR]
+//   tonus-viewer-fixture [--port N] [--seconds S] [--rate HZ] [--playback] [--web-root DIR] [--vrm FILE]
 //
 // Prints "viewer: http://127.0.0.1:PORT/" once listening (the line tonusd
 // prints too), then serves until --seconds pass (0: until SIGINT/SIGTERM).
@@ -201,6 +201,7 @@ struct Options {
   double rate_hz = 30.0;
   bool playback = false;
   std::string web_root = tv::default_web_root();
+  std::string vrm;
 };
 
 int run(int argc, char** argv) {
@@ -212,7 +213,14 @@ int run(int argc, char** argv) {
   app.add_option("--rate", o.rate_hz, "frames per second")->check(CLI::Range(1.0, 240.0));
   app.add_flag("--playback", o.playback, "pretend to replay a 12 s recording: frames carry playback, seekable");
   app.add_option("--web-root", o.web_root, "the page's folder");
+  app.add_option("--vrm", o.vrm, "a .vrm avatar for the page (checked as tonusd checks viewer.vrm)");
   CLI11_PARSE(app, argc, argv);
+  if (!o.vrm.empty()) {
+    if (const tv::VrmFileInfo info = tv::check_vrm_file(o.vrm); !info.error.empty()) {
+      std::cerr << "tonus-viewer-fixture: --vrm " << o.vrm << ": " << info.error << "\n";
+      return 2;
+    }
+  }
 
   const sim::BuildResult built = sim::build_humanoid(sim::HumanoidSpec{});
   if (!built) {
@@ -227,6 +235,7 @@ int run(int argc, char** argv) {
   tv::ViewerConfig config;
   config.port = o.port;
   config.web_root = o.web_root;
+  config.vrm_file = o.vrm;
   tv::ViewerServer viewer(config);
   viewer.set_scene(tonus::daemon::make_viewer_scene(model, o.playback ? "replay" : "live"));  // as tonusd's
   viewer.set_request_handler([&handler](std::string_view method, std::string_view path, std::string_view body) {

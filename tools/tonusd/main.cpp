@@ -58,6 +58,8 @@ int run(int argc, char** argv) {
   app.add_flag("--hold", hold, "--replay: stay at the end, paused, for the viewer to seek back (until Ctrl-C)");
   app.add_option("--viewer-port", viewer_port, "viewer.port: the live web viewer (0: any free port)");
   app.add_flag("--no-viewer", no_viewer, "viewer.enabled = false");
+  std::string vrm_path;
+  app.add_option("--vrm", vrm_path, "viewer.vrm: a .vrm avatar (VRoid, VSeeFace) the page drives with the pose");
   app.add_option("--band", band_source, "band.source: sim, socket, hid, can, candump, none");
   app.add_option("--band-socket", band_socket, "band.sim_socket: a tonus-band-sim serving --hid-socket PATH");
   app.add_option("--band-candump", candump_path, "band.candump_path: a candump log to replay");
@@ -124,6 +126,7 @@ int run(int argc, char** argv) {
   if (no_control) cfg.control.enabled = false;
   if (viewer_port >= 0) cfg.viewer.port = viewer_port;
   if (no_viewer) cfg.viewer.enabled = false;
+  if (!vrm_path.empty()) cfg.viewer.vrm = vrm_path;
   if (no_realtime) {
     cfg.physics.realtime_priority = 0;
     cfg.physics.lock_memory = false;
@@ -153,6 +156,10 @@ int run(int argc, char** argv) {
     cfg.band.sim_args = {"--swell-period", fmt::format("{}", cfg.demo.seconds)};
   }
   if (const std::string e = validate(cfg); !e.empty()) {
+    std::cerr << "tonusd: " << e << "\n";
+    return 2;
+  }
+  if (const std::string e = check_files(cfg); !e.empty()) {
     std::cerr << "tonusd: " << e << "\n";
     return 2;
   }

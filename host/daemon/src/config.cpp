@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "tonus/host/viewer/vrm_file.hpp"
 #include "tonus/sim/human_bones.hpp"
 
 namespace tonus::daemon {
@@ -103,6 +104,15 @@ std::string validate(const DaemonConfig& c) {
     }
     if (!sim::bone_from_name(g.bone)) {
       return fmt::format("demo.gifts[{}].bone = \"{}\": not a humanoid bone (HumanBodyBones name)", i, g.bone);
+    }
+  }
+  return {};
+}
+
+std::string check_files(const DaemonConfig& c) {
+  if (c.viewer.enabled && !c.viewer.vrm.empty()) {
+    if (const viewer::VrmFileInfo info = viewer::check_vrm_file(c.viewer.vrm); !info.error.empty()) {
+      return fmt::format("viewer.vrm = \"{}\": {}", c.viewer.vrm, info.error);
     }
   }
   return {};

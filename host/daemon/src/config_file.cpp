@@ -271,6 +271,7 @@ std::string read_all(const toml::table& root, DaemonConfig& c) {
     r.get("allow_remote", k.allow_remote);
     r.get("rate_hz", k.rate_hz);
     r.get("web_root", k.web_root);
+    r.get("vrm", k.vrm);
     r.finish();
     if (!r.error_.empty()) return r.error_;
   }
@@ -367,6 +368,7 @@ std::string to_toml(const DaemonConfig& c) {
   out += fmt::format("enabled = {}\naddress = {}\nport = {}\nallow_remote = {}\nrate_hz = {}\nweb_root = {}\n",
                      c.viewer.enabled, q(c.viewer.address), c.viewer.port, c.viewer.allow_remote, c.viewer.rate_hz,
                      q(c.viewer.web_root));
+  out += fmt::format("vrm = {}  # a .vrm avatar for the page; empty: none\n", q(c.viewer.vrm));
   out += "\n[log]\n";
   out += fmt::format("level = {}\nstatus_interval_s = {}\n", q(c.log.level), c.log.status_interval_s);
   out += "\n[demo]\n";

@@ -51,6 +51,7 @@ nlohmann::json levels_json(const Levels& l) {
 
 std::unique_ptr<Daemon> Daemon::create(const DaemonConfig& config, std::string tools_dir, std::string& error) {
   if (error = validate(config); !error.empty()) return nullptr;
+  if (error = check_files(config); !error.empty()) return nullptr;
   auto d = std::unique_ptr<Daemon>(new Daemon());
   d->config_ = config;
   sim::BuildResult built = sim::build_humanoid(sim::HumanoidSpec{});

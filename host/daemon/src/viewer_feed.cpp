@@ -58,11 +58,17 @@ viewer::Scene make_viewer_scene(const sim::Model& model, const std::string& mode
     s.geoms.push_back(gi);
     has_shape[static_cast<std::size_t>(geom.body)] = true;
   }
+  // The rest pose (a T-pose for tonusd's humanoid): the page drives a VRM's
+  // bones by their rotation from it.
+  const std::unique_ptr<sim::Data> rest = sim::make_data(model);
+  std::vector<viewer::BonePose> rest_poses;
+  pose_bodies(model, *rest, model.qpos0, rest_poses);
   for (int b = 0; b < model.nbody; ++b) {
     const sim::Body& body = model.bodies[static_cast<std::size_t>(b)];
     viewer::BoneInfo bi;
     bi.name = std::string(body.name_view());
     bi.parent = body.parent;
+    bi.rest = rest_poses[static_cast<std::size_t>(b)];
     if (const auto bone = sim::bone_from_name(bi.name)) {
       const std::int8_t g = stiffness.bone_group[sim::index(*bone)];
       bi.group = g < 0 ? -1 : static_cast<int>(static_cast<std::uint8_t>(g));
@@ -195,6 +201,7 @@ bool ViewerFeed::start(std::string& error, control::Handler* control, bool read_
   vc.port = config_.port;
   vc.allow_remote = config_.allow_remote;
   if (!config_.web_root.empty()) vc.web_root = config_.web_root;
+  vc.vrm_file = config_.vrm;
   server_ = std::make_unique<viewer::ViewerServer>(vc);
   if (control != nullptr) {
     server_->set_request_handler(

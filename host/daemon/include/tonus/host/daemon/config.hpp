@@ -90,6 +90,7 @@ struct ViewerConfig {
   bool allow_remote = false;  // must be true for any address beyond loopback
   double rate_hz = 50.0;      // frames a second to the page (30..60 is plenty)
   std::string web_root;       // empty: the page in the source tree (host/viewer/web)
+  std::string vrm;            // a .vrm avatar the page draws beside the capsules; empty: none
 };
 
 struct LogConfig {
@@ -125,7 +126,13 @@ struct DaemonConfig {
 std::vector<ScheduledGift> default_demo_gifts(double seconds);
 
 // Empty when usable, else "key = value: what is wrong" for the first bad key.
+// Values only: no file is opened (a recording's config validates anywhere).
 std::string validate(const DaemonConfig& c);
+
+// The files the run needs before anything starts: viewer.vrm (when the viewer
+// is on) must be a glTF binary under the size cap (viewer/vrm_file.hpp).
+// Empty, or "key = value: what is wrong".
+std::string check_files(const DaemonConfig& c);
 
 std::string_view to_string(BandSource s);
 std::string_view to_string(SimLink s);
