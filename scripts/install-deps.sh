@@ -56,7 +56,7 @@ if [ ${#missing[@]} -gt 0 ]; then
   fi
 fi
 
-# The viewer's npm packages (three, puppeteer-core), exactly as locked;
+# The viewer's npm packages (three, @pixiv/three-vrm, puppeteer-core), exactly as locked;
 # --ignore-scripts: no install script runs, so no browser is downloaded.
 # Skipped while node_modules matches the lock file.
 web=host/viewer/web

@@ -149,6 +149,39 @@ export function startViewer() {
     state.pending = state.shownFrame;
   });
 
+  // The VRM avatar (when the scene names one): its status line and its and
+  // the capsules' checkboxes. Once it loads the capsules step aside, unless
+  // the user chose; when it fails they are back, whatever was chosen.
+  let capsulesChosen = false;
+  const setCapsules = (shown) => {
+    $('show-capsules').checked = shown;
+    if (view) view.showCapsules = shown;
+    state.pending = state.shownFrame;
+  };
+  $('show-capsules').addEventListener('change', (e) => {
+    capsulesChosen = true;
+    setCapsules(e.target.checked);
+  });
+  $('show-vrm').addEventListener('change', (e) => {
+    if (view) view.vrm.setVisible(e.target.checked);
+    state.pending = state.shownFrame;
+  });
+  if (view) {
+    view.onVrmChange = (avatar) => {
+      const line = $('vrm-status');
+      line.hidden = avatar.state === 'none';
+      line.dataset.state = avatar.state;
+      line.textContent = avatar.state === 'failed' ? `VRM avatar: ${avatar.message}; showing the capsules` :
+        `VRM avatar: ${avatar.message}`;
+      line.className = `status ${avatar.state === 'failed' ? 'bad' : avatar.state === 'loaded' ? 'good' : ''}`;
+      $('vrm-toggle').hidden = avatar.state !== 'loaded';
+      if (avatar.state === 'loaded' && !capsulesChosen) setCapsules(false);
+      if (avatar.state === 'failed' || avatar.state === 'none') setCapsules(true);
+      if (avatar.state === 'loaded') view.vrm.setVisible($('show-vrm').checked);
+      state.pending = state.shownFrame;
+    };
+  }
+
   // Timeline (only shown while frames carry "playback").
   const seek = $('seek');
   seek.addEventListener('pointerdown', () => { panel.seeking = true; });
@@ -183,6 +216,22 @@ export function startViewer() {
     get webgl() { return view !== null; },
     get lastReply() { return state.lastReply; },
     get lastError() { return state.lastError; },
+    get capsulesShown() { return view ? view.showCapsules : false; },
+    // The VRM avatar: state ('none', 'loading', 'loaded', 'failed'), its
+    // message, and what was driven (the frame's tick, the normalized local
+    // rotations and hips position set; the model's bones as drawn).
+    get vrm() {
+      const avatar = view ? view.vrm : null;
+      return {
+        state: avatar ? avatar.state : 'none',
+        message: avatar ? avatar.message : '',
+        version: avatar ? avatar.version : null,
+        visible: avatar ? avatar.visible && avatar.state === 'loaded' : false,
+        applied: avatar && avatar.applied ? structuredClone(avatar.applied) : null,
+        normalizedLocal: (name) => (avatar ? avatar.normalizedLocal(name) : null),
+        rawWorldPosition: (name) => (avatar ? avatar.rawWorldPosition(name) : null),
+      };
+    },
   };
 
   connection.start();

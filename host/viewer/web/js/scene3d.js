@@ -1,10 +1,13 @@
 // The 3D view (three.js): the avatar (simulation B) as shaded shapes from
 // the scene's geoms, the reference as a translucent ghost, the objects, the
-// ground grid, the ZMP and the support polygon, and contact forces as arrows.
+// ground grid, the ZMP and the support polygon, and contact forces as arrows;
+// and, when the scene names one, a VRM avatar driven by the same pose
+// (avatar_vrm.js).
 // tonus is Z up, three.js Y up: everything of tonus's lives in `world`, a
 // group rotated -90 degrees about X (tonus (x, y, z) -> three (x, z, -y)).
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { VrmAvatar } from './avatar_vrm.js';
 import { poseUsable, vecUsable } from './format.js';
 
 const MAX_CONTACTS = 64;
@@ -123,7 +126,14 @@ export class View3D {
     }
     this.showGhost = true;
     this.showContacts = true;
+    this.showCapsules = true;
     this.groundZ = 0;
+    this.onVrmChange = null; // set by the page: the VRM avatar's state changed
+    this.vrm = new VrmAvatar(this.world, (avatar) => {
+      this.dirty = true;
+      if (this.onVrmChange) this.onVrmChange(avatar);
+    });
+    this.lastRenderMs = performance.now();
 
     this.resize();
     this.resizeObserver = new ResizeObserver(() => this.resize());
@@ -193,6 +203,7 @@ export class View3D {
       ghost.renderOrder = 1;
       this.ghostBones[geom.bone].add(ghost);
     }
+    this.vrm.setScene(scene);
   }
 
   clearObjects() {
@@ -218,8 +229,9 @@ export class View3D {
   // Applies a frame message.
   setFrame(frame) {
     this.dirty = true;
-    this.poseBones(this.avatarBones, frame.avatar, true);
+    this.poseBones(this.avatarBones, frame.avatar, this.showCapsules);
     this.poseBones(this.ghostBones, frame.reference, this.showGhost);
+    this.vrm.pose(frame);
 
     const stiffness = Array.isArray(frame.stiffness) ? frame.stiffness : [];
     for (let i = 0; i < this.avatarMaterials.length; i++) {
@@ -310,6 +322,9 @@ export class View3D {
     const moved = this.controls.update();
     if (!moved && !this.dirty) return false;
     this.dirty = false;
+    const now = performance.now();
+    this.vrm.update((now - this.lastRenderMs) / 1000);
+    this.lastRenderMs = now;
     this.renderer.render(this.scene, this.camera);
     return true;
   }
