@@ -138,9 +138,11 @@ IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calib
   const IkOptions& o = options;
   const bool times_ok = o.step_time_s > 0.0 && o.step_time_min_s > 0.0 && o.step_time_min_s <= o.step_time_s &&
                         o.hold_s >= 0.0 && o.ease_s >= 0.0 && o.recover_s >= 0.0 && o.step_lead_s >= 0.0 &&
-                        o.velocity_time_constant_s >= 0.0 && o.trunk_smoothing_s >= 0.0 && o.elbow_smoothing_s >= 0.0;
-  const bool sizes_ok =
-      o.step_threshold_m > 0.0 && o.step_turn_rad > 0.0 && o.step_lift_m >= 0.0 && o.implausible_reach_factor > 1.0;
+                        o.velocity_time_constant_s >= 0.0 && o.trunk_smoothing_s >= 0.0 && o.elbow_smoothing_s >= 0.0 &&
+                        o.stride_soft_fade_s >= 0.0;
+  const bool sizes_ok = o.step_threshold_m > 0.0 && o.step_turn_rad > 0.0 && o.step_lift_m >= 0.0 &&
+                        o.implausible_reach_factor > 1.0 && o.leg_softness_m >= 0.0 && o.stride_softness_m >= 0.0 &&
+                        o.stride_soft_speed_mps > 0.0;
   const bool shares_ok = o.pelvis_share >= 0.0 && o.spine_share >= 0.0 && o.chest_share >= 0.0 && o.neck_share >= 0.0 &&
                          o.pelvis_share <= 1.0 && o.spine_share <= 1.0 && o.chest_share <= 1.0 && o.neck_share <= 1.0 &&
                          o.hands_heading_weight >= 0.0 && o.clavicle_share >= 0.0 && o.clavicle_raise_share >= 0.0 &&
@@ -455,6 +457,11 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
                           ((pelvis_now - st.last_pelvis) / dt - st.pelvis_velocity);
   }
   st.last_pelvis = pelvis_now;
+  // The procedural legs' soft reach: in with the pelvis's speed, out when it stands.
+  const double soft_wanted = std::clamp(horizontal(st.pelvis_velocity).norm() / o.stride_soft_speed_mps, 0.0, 1.0);
+  st.stride_soft_share = st.started ? st.stride_soft_share + detail::first_order_share(dt, o.stride_soft_fade_s) *
+                                                                 (soft_wanted - st.stride_soft_share)
+                                    : 0.0;
   const double pelvis_yaw = yaw_of(w.f.rot[0] * Vec3::UnitX(), yaw);
   if (!st.started) detail::plant_feet(m, st, pelvis_now, pelvis_yaw);
   std::array<Vec3, 2> hip{};
@@ -499,8 +506,10 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
                                                    out.use[index(kKnee[s])]);
       pole = k.pos_m - hip[s];
     }
+    const bool procedural = !(m.calibration.offset[index(kFootTracker[s])].valid && ft.seen);
+    const double softness = o.leg_softness_m + (procedural ? st.stride_soft_share * o.stride_softness_m : 0.0);
     detail::TwoBoneLimb limb{m.rest_dir[bi(thigh)], m.rest_dir[bi(shank)], m.hinge_axis[bi(shank)],
-                             m.thigh_m[s],          m.shank_m[s],          o.leg_softness_m};
+                             m.thigh_m[s],          m.shank_m[s],          softness};
     const detail::TwoBoneSolution sol =
         detail::solve_two_bone(limb, hip[s], target.pos_m, pole, body_yaw * Vec3::UnitX());
     double angle = sol.hinge_rad;

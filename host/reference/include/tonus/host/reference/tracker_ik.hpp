@@ -55,9 +55,18 @@ struct IkOptions {
   double clavicle_raise_share = 0.25;  // added in proportion to how far above the shoulder the hand is
   double default_pole_weight = 0.25;   // elbows: the anatomical pole (down, back) against the hand's
   double arm_softness_m = 0.002;       // soft reach near a straight arm (the wrist short by at most 0.37 of it)
-  double leg_softness_m = 0.0;         // ... and leg (0: a standing leg straight, its foot on the floor)
-  double elbow_smoothing_s = 0.05;     // time constant of the elbows' pole (0: none)
-  double knee_smoothing_s = 0.05;      // ... and the knees'
+  double leg_softness_m = 0.0;         // ... and leg, always (0: a standing leg straight, its foot on the floor)
+  // Procedural feet (3 points) only: a soft reach that fades in with the
+  // pelvis's horizontal speed, full at stride_soft_speed_mps. Near a straight
+  // leg the knee moves as the square root of the slack, so a walking pelvis
+  // that straightens the stance leg jerks the knee; soft, the heel rises a
+  // little instead. Standing still it fades out (over stride_soft_fade_s), so
+  // a standing leg is straight and its foot exactly on the floor.
+  double stride_softness_m = 0.02;
+  double stride_soft_speed_mps = 0.3;
+  double stride_soft_fade_s = 0.2;
+  double elbow_smoothing_s = 0.05;  // time constant of the elbows' pole (0: none)
+  double knee_smoothing_s = 0.05;   // ... and the knees'
   // Steps (3 points).
   double step_threshold_m = 0.12;  // a planted foot further than this from its place under the hip steps
   double step_turn_rad = 0.6;      // ... or turned further than this from the pelvis's heading
@@ -166,6 +175,7 @@ struct IkState {
   std::array<sim::Vec3, 2> knee_pole{};          // in the world, smoothed, unit
   sim::Vec3 last_pelvis = sim::Vec3::Zero();
   sim::Vec3 pelvis_velocity = sim::Vec3::Zero();
+  double stride_soft_share = 0.0;  // [0, 1]: how much of stride_softness_m the procedural legs take now
   struct Foot {
     sim::Vec3 planted = sim::Vec3::Zero();  // ankle joint position
     double yaw_rad = 0.0;
