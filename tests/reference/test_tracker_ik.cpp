@@ -289,6 +289,65 @@ TEST_CASE("tracker IK: walking forward, the feet step after the pelvis and stand
   }
 }
 
+TEST_CASE("tracker IK: procedural legs reach softly while walking, exactly standing") {
+  // The same stream solved with the soft stride and without it: the feet's
+  // targets are the same (steps follow the pelvis, not the legs).
+  IkRig rig = make_ik_rig(1.70, 3, {}, true);
+  IkOptions exact_opt;
+  exact_opt.stride_softness_m = 0.0;
+  IkRig exact_rig = make_ik_rig(1.70, 3, exact_opt, true);
+  Walker w{rig, {}, {}, {}}, e{exact_rig, {}, {}, {}};
+  const double dt = 1.0 / 90.0;
+  const auto both = [&](double t, const Vec3& root) {
+    w.at(t, root, 0.0);
+    e.at(t, root, 0.0);
+  };
+  int k = 0;
+  both(0.0, Vec3(0.0, 0.0, 0.901));
+  CHECK(w.state.stride_soft_share == 0.0);  // a first frame (a reset) stands straight
+  CHECK(w.out.qpos == e.out.qpos);
+  double softest = 0.0;
+  for (; k * dt <= 1.5; ++k) {
+    both(k * dt, Vec3(k * dt * 1.0, 0.0, 0.901));  // 1 m/s
+    // Walking, a stance leg never quite straightens (its knee moves smoothly
+    // near full extension) and never pushes its foot through the floor.
+    const auto j = solved_joints(rig, w.out.qpos);
+    for (const Bone shank : {Bone::LeftLowerLeg, Bone::RightLowerLeg}) {
+      const auto a = static_cast<std::size_t>(rig.solved->bodies[sim::index(shank)].qpos_adr);
+      CHECK(w.out.qpos[a] >= e.out.qpos[a] - 1e-9);
+      softest = std::max(softest, w.out.qpos[a] - e.out.qpos[a]);
+      CHECK(j[sim::index(shank) + 1].z() > rig.ik->ankle_height_m - kMm);
+    }
+  }
+  CHECK(w.state.stride_soft_share > 0.9);
+  CHECK(softest > 0.05);  // rad: the soft knees bend where the exact ones snap straight
+  for (const double stop = k * dt; k * dt <= stop + 1.5; ++k) both(k * dt, Vec3(stop, 0.0, 0.901));  // stands
+  CHECK(w.state.stride_soft_share < 0.01);
+  // Standing, the legs are the exact solver's: the feet (on the floor when
+  // in reach) to 0.2 mm. A straight knee moves as the square root of the
+  // slack, so the fading softness still shows there: a bend of about 0.013 rad.
+  const auto j = solved_joints(rig, w.out.qpos);
+  const auto je = solved_joints(exact_rig, e.out.qpos);
+  for (std::size_t b = 0; b < sim::kBoneCount; ++b) {
+    CAPTURE(sim::kBones[b].name);
+    const bool knee = b == sim::index(Bone::LeftLowerLeg) || b == sim::index(Bone::RightLowerLeg);
+    CHECK((j[b] - je[b]).norm() < (knee ? 5.0 : 0.2) * kMm);
+  }
+  for (const Bone shank : {Bone::LeftLowerLeg, Bone::RightLowerLeg}) {
+    const auto a = static_cast<std::size_t>(rig.solved->bodies[sim::index(shank)].qpos_adr);
+    CHECK(std::abs(w.out.qpos[a] - e.out.qpos[a]) < 0.02);
+  }
+  // 6 points: tracked feet are reached exactly however fast the pelvis moves.
+  IkRig six = make_ik_rig(1.70, 6, {}, true);
+  Walker v{six, {}, {}, {}};
+  double worst = 0.0;
+  for (int i = 0; i * dt <= 1.5; ++i) {
+    v.at(i * dt, Vec3(i * dt * 1.0, 0.0, 0.901), 0.0);
+    worst = std::max({worst, v.out.foot_error_m[0], v.out.foot_error_m[1]});
+  }
+  CHECK(worst < kMm);
+}
+
 TEST_CASE("tracker IK: bad input is ignored, held, eased, flagged, never a NaN") {
   IkOptions opt;
   opt.hold_s = 0.2;

@@ -458,7 +458,8 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
   }
   st.last_pelvis = pelvis_now;
   // The procedural legs' soft reach: in with the pelvis's speed, out when it stands.
-  const double soft_wanted = std::clamp(horizontal(st.pelvis_velocity).norm() / o.stride_soft_speed_mps, 0.0, 1.0);
+  const double speed = horizontal(st.pelvis_velocity).norm();
+  const double soft_wanted = std::isfinite(speed) ? std::clamp(speed / o.stride_soft_speed_mps, 0.0, 1.0) : 0.0;
   st.stride_soft_share = st.started ? st.stride_soft_share + detail::first_order_share(dt, o.stride_soft_fade_s) *
                                                                  (soft_wanted - st.stride_soft_share)
                                     : 0.0;
