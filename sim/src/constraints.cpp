@@ -304,8 +304,7 @@ void assemble_rows(const Model& model, Data& data) {
       }
     }
     row.diag = diag;
-    if (row.kind == Row::Kind::normal || row.kind == Row::Kind::limit)
-      row.bound = diag > kRowMinDiag ? kMaxRowSpeedChange / diag : 0.0;
+    if (is_unilateral(row)) row.bound = diag > kRowMinDiag ? kMaxRowSpeedChange / diag : 0.0;
     row.pre = v_pre;
     row.v0 = v_free;
     if (!(diag > kRowMinDiag)) row.lambda = 0.0;  // nothing can move along it (e.g. a kinematic body on the ground)

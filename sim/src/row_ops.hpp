@@ -31,6 +31,11 @@ inline bool is_joint_row(const Data::Row& row) {
   return row.kind == Data::Row::Kind::limit || row.kind == Data::Row::Kind::drive;
 }
 
+// Normal and limit rows push only: their impulse lies in [0, bound].
+inline bool is_unilateral(const Data::Row& row) {
+  return row.kind == Data::Row::Kind::normal || row.kind == Data::Row::Kind::limit;
+}
+
 // One past the last row of the drive group that starts at row `first` (a ball
 // joint's three rows are projected together).
 inline std::size_t drive_group_end(const Data& data, std::size_t first) {

@@ -242,7 +242,7 @@ void momentum(Data& data, int begin, int end, double& gg_prev, bool& have_dir) {
     // next sweep clips it back by as much, the change stays the same, beta
     // stays 1, and the pair cycles forever (a toe resting on the floor did,
     // for hundreds of steps, at 1.6e-6 m/s).
-    const bool at_zero = (row.kind == Row::Kind::normal || row.kind == Row::Kind::limit) && row.lambda <= 0.0;
+    const bool at_zero = is_unilateral(row) && row.lambda <= 0.0;
     const double step = at_zero ? 0.0 : beta * data.solve_dir[r];
     if (step != 0.0) {
       apply_row_impulse(data, row, step);
@@ -461,16 +461,14 @@ bool subspace_solve(Data& data, int begin, int end, size_t& m) {
     for (size_t i = 0; i < m; ++i) {
       const auto r = static_cast<size_t>(data.subspace_rows[i]);
       const Row& row = data.rows[r];
-      if (row.kind != Row::Kind::normal && row.kind != Row::Kind::limit) continue;
+      if (!is_unilateral(row)) continue;
       if (row.lambda + data.subspace_rhs[i] >= 0.0) continue;
       pulls = true;
       released.set(r);
       if (row.kind != Row::Kind::normal) continue;
       // Its contact's friction rows follow it.
-      for (size_t k = r + 1; k < static_cast<size_t>(data.nrows) && data.rows[k].contact == row.contact; ++k) {
-        if (data.rows[k].kind == Row::Kind::normal) break;
+      for (size_t k = r + 1; k < static_cast<size_t>(data.nrows) && data.rows[k].contact == row.contact; ++k)
         released.set(k);
-      }
     }
     if (!pulls) break;
   }
