@@ -100,6 +100,27 @@ struct Connection {
   Clock::time_point over_since;
 };
 
+// A short plain-text reply (errors, refusals).
+void reply_text(const WsServer::connection_ptr& con, websocketpp::http::status_code::value status,
+                const std::string& body) {
+  con->set_status(status);
+  con->replace_header("Content-Type", "text/plain; charset=utf-8");
+  con->set_body(body + "\n");
+}
+
+// 200 with a file's bytes; a HEAD request gets only their length.
+void reply_body(const WsServer::connection_ptr& con, const std::string& method, const std::string& content_type,
+                const std::string& body) {
+  con->set_status(websocketpp::http::status_code::ok);
+  con->replace_header("Content-Type", content_type);
+  if (method == "HEAD") {
+    con->set_body("");
+    con->replace_header("Content-Length", std::to_string(body.size()));
+  } else {
+    con->set_body(body);
+  }
+}
+
 }  // namespace
 
 bool is_loopback_address(std::string_view address) {
@@ -344,9 +365,7 @@ struct ViewerServer::Impl {
     const std::string path = con->get_request().get_uri();
     auto refuse = [&](websocketpp::http::status_code::value status, const std::string& why) {
       ++counters.connections_refused;
-      con->set_status(status);
-      con->set_body(why + "\n");
-      con->replace_header("Content-Type", "text/plain; charset=utf-8");
+      reply_text(con, status, why);
       return false;
     };
     if (path.substr(0, path.find('?')) != "/ws") {
@@ -514,9 +533,7 @@ struct ViewerServer::Impl {
     con->replace_header("Cache-Control", "no-cache");
     con->replace_header("X-Content-Type-Options", "nosniff");
     auto text = [&](websocketpp::http::status_code::value status, const std::string& body) {
-      con->set_status(status);
-      con->replace_header("Content-Type", "text/plain; charset=utf-8");
-      con->set_body(body + "\n");
+      reply_text(con, status, body);
     };
     if (!host_allowed(con)) {
       text(websocketpp::http::status_code::forbidden, "Host is not a loopback name");
@@ -543,27 +560,18 @@ struct ViewerServer::Impl {
       return;
     }
     std::string error;
-    std::string body = read_file(file.file, error);
+    const std::string body = read_file(file.file, error);
     if (!error.empty()) {
       text(websocketpp::http::status_code::internal_server_error, error);
       return;
     }
-    con->set_status(websocketpp::http::status_code::ok);
-    con->replace_header("Content-Type", std::string(mime_type(file.file)));
-    if (method == "HEAD") {
-      con->set_body("");
-      con->replace_header("Content-Length", std::to_string(body.size()));
-    } else {
-      con->set_body(body);
-    }
+    reply_body(con, method, std::string(mime_type(file.file)), body);
   }
 
   // The configured avatar, and only it: the request's path picks no file.
   void serve_vrm(const WsServer::connection_ptr& con, const std::string& method) const {
     auto text = [&](websocketpp::http::status_code::value status, const std::string& body) {
-      con->set_status(status);
-      con->replace_header("Content-Type", "text/plain; charset=utf-8");
-      con->set_body(body + "\n");
+      reply_text(con, status, body);
     };
     if (config.vrm_file.empty()) {
       text(websocketpp::http::status_code::not_found, "no VRM avatar: start tonusd with --vrm FILE");
@@ -582,14 +590,7 @@ struct ViewerServer::Impl {
       text(websocketpp::http::status_code::internal_server_error, error);
       return;
     }
-    con->set_status(websocketpp::http::status_code::ok);
-    con->replace_header("Content-Type", "model/gltf-binary");  // whatever the file is named
-    if (method == "HEAD") {
-      con->set_body("");
-      con->replace_header("Content-Length", std::to_string(body.size()));
-    } else {
-      con->set_body(body);
-    }
+    reply_body(con, method, "model/gltf-binary", body);  // whatever the file is named
   }
 };
 
