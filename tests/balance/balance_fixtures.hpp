@@ -1,18 +1,14 @@
 // Shared helpers for the balance tests: loading a clip through the whole
-// conversion, and the shared mocap clips' paths.
+// conversion (the clips' paths are in clip_paths.hpp).
 #pragma once
 
 #include <string>
 
+#include "clip_paths.hpp"
 #include "tonus/host/balance/convert.hpp"
 #include "tonus/host/motion/bvh.hpp"
 
 namespace tonus::balance::test {
-
-inline std::string shared_clip(const std::string& name) { return std::string(TONUS_SHARED_DATA_DIR) + "/bvh/" + name; }
-inline std::string bundled_clip(const std::string& name) {
-  return std::string(TONUS_SOURCE_DIR) + "/tests/data/" + name;
-}
 
 struct Loaded {
   motion::Clip clip;
