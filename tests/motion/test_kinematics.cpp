@@ -9,6 +9,7 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "bvh_samples.hpp"
 #include "support/allocation_counter.hpp"
@@ -156,6 +157,62 @@ TEST_CASE("fk: writing a rotation back into the joint's own channels") {
   CHECK_FALSE(set_local_rotation(clip, 0, 3, q));
   CHECK_FALSE(set_local_rotation(clip, 0, 1, Eigen::Quaterniond(0, 0, 0, 0)));
   CHECK_FALSE(set_local_rotation(clip, 0, 1, Eigen::Quaterniond(kNaN, 0, 0, 1)));
+  CHECK(clip.values == values);
+}
+
+TEST_CASE("fk: unwrapping a joint's angles changes no rotation and removes representation jumps") {
+  using Q = Eigen::Quaterniond;
+  const auto about = [](double degrees, int axis) {
+    return Q(Eigen::AngleAxisd(degrees * std::numbers::pi / 180.0, Eigen::Vector3d::Unit(axis)));
+  };
+  // The arm's order is xzy: through the +-180 wrap of its first angle, through
+  // gimbal lock (middle angle 90) and passing 3 degrees from it.
+  for (int path = 0; path < 3; ++path) {
+    CAPTURE(path);
+    constexpr std::size_t kFrames = 40;
+    Clip clip = tonus::test::synthetic_clip(kFrames, 26);
+    for (std::size_t f = 0; f < kFrames; ++f) {
+      const double t = static_cast<double>(f);
+      const Q q = path == 0   ? about(160.0 + t, 0) * about(20, 2) * about(5, 1)
+                  : path == 1 ? about(70.0 + t, 2) * about(10, 1)
+                              : about(3, 1) * about(70.0 + t, 2) * about(10, 1);
+      const EulerAngles principal = euler_from_quaternion(q, EulerOrder::xzy);
+      for (std::size_t i = 0; i < 3; ++i) clip.frame(f)[6 + i] = principal.at(i);
+    }
+    const Clip before = clip;
+    // Frames whose arm angles move by more than `degrees` from the previous frame's.
+    const auto jumps = [](const Clip& c, double degrees = 90.0) {
+      std::vector<std::size_t> at;
+      for (std::size_t f = 1; f < c.frame_count; ++f) {
+        for (std::size_t i = 6; i < 9; ++i) {
+          if (std::abs(c.frame(f)[i] - c.frame(f - 1)[i]) > degrees) {
+            at.push_back(f);
+            break;
+          }
+        }
+      }
+      return at;
+    };
+    REQUIRE(!jumps(before).empty());
+    // Until the input's angles first leap (the path moves a degree a frame)
+    // they were already the nearest, so they must be kept exactly.
+    const std::vector<std::size_t> leaps = jumps(before, 20.0);
+    const std::size_t kept_until = leaps.empty() ? kFrames : leaps.front();
+    REQUIRE(unwrap_rotation(clip, 1, 0));
+    CHECK(jumps(clip).empty());
+    for (std::size_t f = 0; f < kFrames; ++f) {
+      CHECK(local_rotation(clip, f, 1)->angularDistance(*local_rotation(before, f, 1)) < 1e-12);
+      for (std::size_t i = 0; i < 6; ++i) CHECK(clip.frame(f)[i] == before.frame(f)[i]);  // the root's untouched
+      if (f < kept_until) {
+        for (std::size_t i = 6; i < 9; ++i) CHECK(clip.frame(f)[i] == before.frame(f)[i]);
+      }
+    }
+  }
+  Clip clip = tonus::test::synthetic_clip(3, 27);
+  const std::vector<double> values = clip.values;
+  CHECK_FALSE(unwrap_rotation(clip, 2, 0));  // an End Site
+  CHECK_FALSE(unwrap_rotation(clip, 3, 0));
+  CHECK_FALSE(unwrap_rotation(clip, 1, 3));
   CHECK(clip.values == values);
 }
 

@@ -141,6 +141,44 @@ bool set_local_rotation(Clip& clip, std::size_t frame, std::size_t joint, const 
   return true;
 }
 
+bool unwrap_rotation(Clip& clip, std::size_t joint, std::size_t from_frame) {
+  if (joint >= clip.joints.size() || clip.frame_count == 0 || !posable(clip, clip.frame_count - 1) ||
+      from_frame >= clip.frame_count) {
+    return false;
+  }
+  const Joint& target = clip.joints[joint];
+  const std::optional<EulerOrder> order = rotation_order(target);
+  if (!order) return false;
+  const std::size_t n = clip.channel_count();
+  std::array<std::size_t, 3> columns{};
+  std::size_t k = 0;
+  for (std::size_t c = 0; c < target.channels.size(); ++c) {
+    if (is_rotation(target.channels[c])) columns.at(k++) = first_column(clip, joint) + c;
+  }
+  const auto angles_at = [&](std::size_t f) {
+    const std::size_t row = f * n;
+    return EulerAngles{clip.values[row + columns[0]], clip.values[row + columns[1]], clip.values[row + columns[2]]};
+  };
+  const auto distance = [](const EulerAngles& a, const EulerAngles& b) {
+    return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+  };
+  // Rounding moves a re-derived triple by ~1e-12 degrees; a different
+  // representation is nearer by far more.
+  constexpr double kNearer = 1e-6;
+  EulerAngles previous = angles_at(from_frame);
+  for (std::size_t f = from_frame + 1; f < clip.frame_count; ++f) {
+    const EulerAngles now = angles_at(f);
+    const EulerAngles near = euler_from_quaternion_near(quaternion_from_euler(*order, now), *order, previous);
+    if (distance(near, previous) < distance(now, previous) - kNearer) {
+      for (std::size_t i = 0; i < 3; ++i) clip.values[f * n + columns.at(i)] = near.at(i);
+      previous = near;
+    } else {
+      previous = now;
+    }
+  }
+  return true;
+}
+
 bool set_local_translation(Clip& clip, std::size_t frame, std::size_t joint, const Eigen::Vector3d& t) {
   if (joint >= clip.joints.size() || !posable(clip, frame) || !t.allFinite()) return false;
   const Joint& target = clip.joints[joint];

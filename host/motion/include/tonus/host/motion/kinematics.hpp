@@ -60,6 +60,15 @@ bool forward_kinematics(const Clip& clip, std::size_t frame, std::vector<JointPo
 // rotation_order, frame or joint is out of range, or q is zero or not finite.
 bool set_local_rotation(Clip& clip, std::size_t frame, std::size_t joint, const Eigen::Quaterniond& q);
 
+// Re-expresses the joint's rotation at every frame after `from_frame` as the
+// angles nearest the previous frame's as this pass leaves them
+// (euler_from_quaternion_near): no rotation changes, only its angles, so the
+// channels jump only where the rotation itself does or an Euler singularity
+// forces it. A frame whose angles are already the nearest (to 1e-6 degrees)
+// keeps them bit for bit, as does `from_frame`. False, and nothing changed,
+// if the joint has no rotation_order or from_frame or joint is out of range.
+bool unwrap_rotation(Clip& clip, std::size_t joint, std::size_t from_frame);
+
 // Writes a translation into the joint's three position channels at `frame`.
 // False, and nothing written, if the joint lacks one of Xposition, Yposition,
 // Zposition, frame or joint is out of range, or t is not finite.
