@@ -2,6 +2,8 @@
 
 #include <doctest/doctest.h>
 
+#include <cmath>
+
 namespace tonus::balance::test {
 
 Loaded load(const std::string& path, const ConvertOptions& options) {
@@ -14,6 +16,31 @@ Loaded load(const std::string& path, const ConvertOptions& options) {
   l.conversion = convert_motion(l.clip, l.mapping, options);
   REQUIRE_MESSAGE(l.conversion.ok(), l.conversion.error);
   return l;
+}
+
+std::vector<std::size_t> rotation_jumps(const motion::Clip& clip, double degrees) {
+  const std::vector<std::size_t> start = motion::channel_columns(clip);
+  std::vector<std::size_t> jumps(clip.channel_count(), 0);
+  for (std::size_t j = 0; j < clip.joints.size(); ++j) {
+    for (std::size_t c = 0; c < clip.joints[j].channels.size(); ++c) {
+      if (!motion::is_rotation(clip.joints[j].channels[c])) continue;
+      const std::size_t column = start[j] + c;
+      for (std::size_t f = 1; f < clip.frame_count; ++f) {
+        if (std::abs(clip.frame(f)[column] - clip.frame(f - 1)[column]) > degrees) ++jumps[column];
+      }
+    }
+  }
+  return jumps;
+}
+
+std::string column_name(const motion::Clip& clip, std::size_t column) {
+  const std::vector<std::size_t> start = motion::channel_columns(clip);
+  for (std::size_t j = 0; j < clip.joints.size(); ++j) {
+    if (column >= start[j] && column < start[j + 1]) {
+      return clip.joints[j].name + " " + std::string(motion::channel_name(clip.joints[j].channels[column - start[j]]));
+    }
+  }
+  return "column " + std::to_string(column);
 }
 
 }  // namespace tonus::balance::test

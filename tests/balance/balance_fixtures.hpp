@@ -2,7 +2,9 @@
 // conversion (the clips' paths are in clip_paths.hpp).
 #pragma once
 
+#include <cstddef>
 #include <string>
+#include <vector>
 
 #include "clip_paths.hpp"
 #include "tonus/host/balance/convert.hpp"
@@ -18,5 +20,12 @@ struct Loaded {
 
 // Reads, maps and converts a clip; fails the test on any error.
 Loaded load(const std::string& path, const ConvertOptions& options = {});
+
+// Euler discontinuities: per column of a frame row, how many consecutive
+// frames differ by more than `degrees` (rotation channels; position columns
+// count zero).
+std::vector<std::size_t> rotation_jumps(const motion::Clip& clip, double degrees = 90.0);
+// "Joint Channel" for a column of a frame row, for messages.
+std::string column_name(const motion::Clip& clip, std::size_t column);
 
 }  // namespace tonus::balance::test

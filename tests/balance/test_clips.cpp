@@ -29,6 +29,20 @@ void check_clip(const std::string& name, const std::string& path) {
   REQUIRE(again.ok());
   const Analysis reread = analyse(again.motion, o.analysis);
   REQUIRE(reread.ok());
+  // No new Euler discontinuities: per rotation channel, the written file has
+  // no more jumps over 90 degrees between frames than the original.
+  const std::vector<std::size_t> jumps_before = test::rotation_jumps(l.clip);
+  const std::vector<std::size_t> jumps_after = test::rotation_jumps(back.clip);
+  REQUIRE(jumps_after.size() == jumps_before.size());
+  std::size_t total_before = 0, total_after = 0;
+  for (std::size_t c = 0; c < jumps_before.size(); ++c) {
+    total_before += jumps_before[c];
+    total_after += jumps_after[c];
+    CHECK_MESSAGE(jumps_after[c] <= jumps_before[c], name << ": " << test::column_name(l.clip, c) << " jumps "
+                                                          << jumps_before[c] << " -> " << jumps_after[c]);
+  }
+  MESSAGE(name << ": Euler jumps over 90 degrees between frames: " << total_before << " in the original, "
+               << total_after << " written");
   double max_correction = 0.0;
   for (const Vec3& d : f.correction) max_correction = std::max(max_correction, d.norm());
   MESSAGE(name << ": " << f.before.summary.frames << " frames, outside before " << f.before.summary.frames_outside

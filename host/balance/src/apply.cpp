@@ -1,6 +1,8 @@
 #include "tonus/host/balance/apply.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace tonus::balance {
 namespace {
@@ -39,6 +41,13 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
     return out;
   }
   const Quatd to_int = file_to_internal();
+  // The first frame each joint's rotation is written at, for the unwrap below.
+  constexpr std::size_t kUnwritten = std::numeric_limits<std::size_t>::max();
+  std::vector<std::size_t> first_written(clip.joints.size(), kUnwritten);
+  const auto write_rotation = [&](std::size_t f, std::size_t j, const Quatd& q) {
+    motion::set_local_rotation(out.clip, f, j, q);
+    first_written[j] = std::min(first_written[j], f);
+  };
   std::vector<motion::JointPose> poses;
   std::vector<Quatd> global;
   double sum_sq = 0.0;
@@ -63,7 +72,7 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
     const int hp = clip.joints[hu].parent;
     const Quatd parent_rot = hp >= 0 ? poses[static_cast<std::size_t>(hp)].rotation : Quatd::Identity();
     const Vec3d parent_pos = hp >= 0 ? poses[static_cast<std::size_t>(hp)].position : Vec3d::Zero();
-    motion::set_local_rotation(out.clip, f, hu, local_from(poses, global, clip, hu));
+    write_rotation(f, hu, local_from(poses, global, clip, hu));
     motion::set_local_translation(out.clip, f, hu, parent_rot.conjugate() * (hips_pos - parent_pos));
     // Below the hips every joint keeps its local rotation (its global turns
     // with the hips), except the thighs, shanks and feet the IK sets; walk the
@@ -105,11 +114,21 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
       below[j] = true;
       if (desired[j] >= 0) {
         global[j] = wanted[static_cast<std::size_t>(desired[j])];
-        motion::set_local_rotation(out.clip, f, j, local_from(poses, global, clip, j));
+        write_rotation(f, j, local_from(poses, global, clip, j));
       } else {
         global[j] = global[static_cast<std::size_t>(par)] * poses[j].local_rotation;
       }
     }
+  }
+  // set_local_rotation chose the angles nearest each frame's original ones,
+  // which near a +-180 wrap or gimbal lock can be far from the previous
+  // written frame's, and an untouched frame after a written one can be far
+  // from it too. Re-expressing every frame of a written joint, from its first
+  // written frame on, nearest the frame before keeps its channels continuous
+  // without changing a rotation.
+  for (std::size_t j = 0; j < first_written.size(); ++j) {
+    if (first_written[j] != kUnwritten)
+      motion::unwrap_rotation(out.clip, j, first_written[j] > 0 ? first_written[j] - 1 : 0);
   }
   // Measure what was written.
   std::vector<motion::JointPose> before, after;

@@ -2,7 +2,10 @@
 // hips joint's rotation and position channels (the waist turns about the
 // midpoint of the hip joints), and the thigh, shank and foot rotations that
 // keep each foot where it was. Each joint keeps its own channel order and its
-// angles stay continuous. The result is measured, not assumed: the feet's
+// angles stay continuous: every joint written is re-expressed, from its first
+// written frame on, as the angles nearest the previous frame's (no rotation
+// changes), so the file gains no Euler jump and loses those the original had
+// in these joints. The result is measured, not assumed: the feet's
 // displacement and the joint-angle change come from forward kinematics of the
 // written clip against the original.
 #pragma once
