@@ -5,6 +5,8 @@
 // numbers are reported.
 #include <doctest/doctest.h>
 
+#include <string>
+
 #include "balance_fixtures.hpp"
 #include "tonus/host/balance/apply.hpp"
 #include "tonus/host/balance/filter.hpp"
@@ -49,8 +51,20 @@ void check_clip(const std::string& name, const std::string& path) {
                << " (max " << f.before.summary.max_outside_m << " m), after " << f.after.summary.frames_outside
                << ", after writing and re-reading " << reread.summary.frames_outside << "; airborne "
                << f.before.summary.frames_airborne << ", unsolved " << f.frames_unsolved << ", feet moved "
-               << applied.max_foot_displacement_m << " m, RMS joint change " << applied.rms_joint_change_rad
-               << " rad, largest waist correction " << max_correction << " rad");
+               << applied.max_foot_displacement_m << " m, largest waist correction " << max_correction << " rad");
+  // The change figures: only what changed, and only the joints the writer sets.
+  std::string largest;
+  for (const JointChange& c : applied.largest_change) {
+    largest += (largest.empty() ? "" : ", ") + c.joint + " " + std::to_string(c.max_rad) + " (frame " +
+               std::to_string(c.frame) + ")";
+    CHECK_MESSAGE(!c.bone.empty(), c.joint);
+  }
+  MESSAGE(name << ": RMS change over changed joints " << applied.rms_change_changed_joints_rad << " rad ("
+               << applied.largest_change.size() << " joints, " << applied.changed_samples
+               << " joint-frames), over every mapped joint " << applied.rms_change_all_mapped_joints_rad
+               << " rad; largest per joint: " << largest);
+  CHECK(applied.rms_change_changed_joints_rad >= applied.rms_change_all_mapped_joints_rad);
+  CHECK(applied.largest_change.size() <= 7);  // hips, thighs, shanks, feet
   CHECK(f.after.summary.frames_outside == 0);
   CHECK(f.after.summary.max_outside_m <= o.analysis.tolerance_m);
   CHECK(reread.summary.frames_outside == 0);

@@ -43,10 +43,17 @@ TEST_CASE("tonus zmp: corrects the bundled walk and writes BVH, CSV, JSON and SV
   CHECK(r.code == 0);
   CHECK(r.out.find("before: ZMP outside") != std::string::npos);
   CHECK(r.out.find("T-pose") != std::string::npos);
+  // The change figures: over the changed joints only, and the largest per joint with its frame.
+  CHECK(r.out.find("RMS change over changed joints") != std::string::npos);
+  CHECK(r.out.find("largest per joint: Hips ") != std::string::npos);
+  CHECK(r.out.find("LeftUpLeg ") != std::string::npos);
   const std::string json = read_file(temp("walk.json"));
-  for (const char* key : {"\"frames\"", "\"frames_outside_before\"", "\"frames_outside_after\": 0,",
-                          "\"max_outside_before_m\"", "\"max_outside_after_m\"", "\"max_foot_displacement_m\"",
-                          "\"rms_joint_change_rad\"", "\"frames_unsolved\": 0,", "\"frames_airborne\""}) {
+  for (const char* key :
+       {"\"frames\"", "\"frames_outside_before\"", "\"frames_outside_after\": 0,", "\"max_outside_before_m\"",
+        "\"max_outside_after_m\"", "\"max_foot_displacement_m\"", "\"rms_joint_change_rad\"", "\"frames_unsolved\": 0,",
+        "\"frames_airborne\"", "\"rms_change_changed_joints_rad\"", "\"changed_joints\": 7,",
+        "\"changed_joint_frames\"", "\"max_change_per_joint\": {",
+        "\"Hips\": {\"bone\": \"Hips\", \"max_rad\": ", "\"LeftUpLeg\": {\"bone\": \"LeftUpperLeg\", \"max_rad\": "}) {
     CHECK_MESSAGE(json.find(key) != std::string::npos, key);
   }
   const std::string csv = read_file(temp("walk.csv"));

@@ -102,7 +102,18 @@ bool write_zmp_json(const std::string& path, const ZmpReport& r, std::string& er
   out += fmt::format("  \"rms_outside_before_m\": {:.6f},\n  \"rms_outside_after_m\": {:.6f},\n", b.rms_outside_m,
                      a.rms_outside_m);
   out += fmt::format("  \"max_foot_displacement_m\": {:.9f},\n", r.max_foot_displacement_m);
-  out += fmt::format("  \"rms_joint_change_rad\": {:.6f},\n", r.rms_joint_change_rad);
+  // rms_joint_change_rad is the older all-mapped-joints figure, kept for existing readers.
+  out += fmt::format("  \"rms_joint_change_rad\": {:.6f},\n", r.rms_change_all_mapped_joints_rad);
+  out += fmt::format("  \"rms_change_changed_joints_rad\": {:.6f},\n", r.rms_change_changed_joints_rad);
+  out += fmt::format("  \"changed_joints\": {},\n  \"changed_joint_frames\": {},\n", r.largest_change.size(),
+                     r.changed_samples);
+  out += "  \"max_change_per_joint\": {";
+  for (std::size_t i = 0; i < r.largest_change.size(); ++i) {
+    const balance::JointChange& c = r.largest_change[i];
+    out += fmt::format("{}\n    {}: {{\"bone\": {}, \"max_rad\": {:.6f}, \"frame\": {}}}", i == 0 ? "" : ",",
+                       json_string(c.joint), json_string(c.bone), c.max_rad, c.frame);
+  }
+  out += r.largest_change.empty() ? "},\n" : "\n  },\n";
   out += fmt::format("  \"max_correction_rad\": {:.6f},\n", r.max_correction_rad);
   out += fmt::format("  \"frames_unsolved\": {},\n", f.frames_unsolved);
   out += fmt::format("  \"frames_airborne\": {},\n", b.frames_airborne);

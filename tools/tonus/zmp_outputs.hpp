@@ -1,9 +1,11 @@
 // The balance report's files: CSV per frame, a JSON report, an SVG plot.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
+#include "tonus/host/balance/apply.hpp"
 #include "tonus/host/balance/filter.hpp"
 
 namespace tonus::tools {
@@ -18,7 +20,10 @@ struct ZmpReport {
   std::size_t frames_total = 0;
   const balance::FilterResult* filter = nullptr;
   double max_foot_displacement_m = 0.0;  // measured on the written clip
-  double rms_joint_change_rad = 0.0;
+  double rms_change_changed_joints_rad = 0.0;
+  std::size_t changed_samples = 0;
+  std::vector<balance::JointChange> largest_change;
+  double rms_change_all_mapped_joints_rad = 0.0;  // the older figure, untouched joints included
   double max_correction_rad = 0.0;
   std::size_t lookahead_frames = 0;
   balance::Vec2 forward = balance::Vec2::UnitX();  // the plots' forward axis in the ground plane

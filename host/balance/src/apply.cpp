@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace tonus::balance {
 namespace {
@@ -132,6 +133,9 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
   }
   // Measure what was written.
   std::vector<motion::JointPose> before, after;
+  double changed_sq = 0.0;
+  std::vector<double> largest(clip.joints.size(), 0.0);
+  std::vector<std::size_t> largest_frame(clip.joints.size(), 0);
   for (std::size_t f = 0; f < clip.frame_count; ++f) {
     motion::forward_kinematics(clip, f, before);
     motion::forward_kinematics(out.clip, f, after);
@@ -148,6 +152,18 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
       out.max_foot_displacement_m =
           std::max(out.max_foot_displacement_m, g.metres_per_unit * (after[ju].position - before[ju].position).norm());
     }
+    // Every joint, mapped or not, but only where the correction changed it:
+    // averaging in untouched joints would understate the edit.
+    for (std::size_t j = 0; j < after.size(); ++j) {
+      const double angle = before[j].local_rotation.angularDistance(after[j].local_rotation);
+      if (angle <= kChangedRad) continue;
+      changed_sq += angle * angle;
+      ++out.changed_samples;
+      if (angle > largest[j]) {
+        largest[j] = angle;
+        largest_frame[j] = f;
+      }
+    }
     if (f < first_frame) continue;
     for (const int j : g.map.joint) {
       if (j < 0) continue;
@@ -157,7 +173,17 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
       ++samples;
     }
   }
-  out.rms_joint_change_rad = samples > 0 ? std::sqrt(sum_sq / static_cast<double>(samples)) : 0.0;
+  out.rms_change_all_mapped_joints_rad = samples > 0 ? std::sqrt(sum_sq / static_cast<double>(samples)) : 0.0;
+  out.rms_change_changed_joints_rad =
+      out.changed_samples > 0 ? std::sqrt(changed_sq / static_cast<double>(out.changed_samples)) : 0.0;
+  for (std::size_t j = 0; j < largest.size(); ++j) {
+    if (largest[j] == 0.0) continue;
+    JointChange c{clip.joints[j].name, {}, largest[j], largest_frame[j]};
+    for (std::size_t b = 0; b < sim::kBoneCount; ++b) {
+      if (g.map.joint[b] == static_cast<int>(j)) c.bone = sim::kBones[b].name;
+    }
+    out.largest_change.push_back(std::move(c));
+  }
   return out;
 }
 
