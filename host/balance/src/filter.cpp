@@ -5,20 +5,19 @@
 #include <Eigen/SparseCore>
 #include <cmath>
 
+#include "accel_operator.hpp"
 #include "tonus/host/balance/zmp.hpp"
-#include "tonus/host/derivatives/batch.hpp"
 
 namespace tonus::balance {
 namespace {
+
+using detail::AccelOperator;
 
 // ZMP-equivalent scales: what one radian of correction, or one rad/s^2 of its
 // angular acceleration, moves the ZMP by, roughly, for an adult (the upper
 // body's mass share times its lever, and that times its height over g).
 constexpr double kSizeScale_m = 0.2;
 constexpr double kAccelScale_m = 0.02;
-// The Jacobian keeps the acceleration operator's entries above this share of
-// its peak (the residuals always use the exact operator).
-constexpr double kBandThreshold = 1e-3;
 
 struct Targets {
   std::vector<bool> active;
@@ -67,46 +66,6 @@ double objective(const Analysis& a, const Targets& t, const std::vector<Vec3>& d
   return cost;
 }
 
-// The analysis' acceleration operator: smoothing and differentiation are
-// linear in the samples (no outlier gate), so a(x + dx) = a(x) + D dx; column j
-// of D is the acceleration of a unit impulse at j. Kept as a band around the
-// diagonal, as wide as an interior column's significant entries.
-struct AccelOperator {
-  std::size_t band = 0;
-  std::size_t n = 0;
-  std::vector<double> coef;  // coef[j * (2 band + 1) + (k + band - j)] = D[k][j]
-  [[nodiscard]] double at(std::size_t k, std::size_t j) const {
-    if (k + band < j || k > j + band) return 0.0;
-    return coef[j * (2 * band + 1) + (k + band - j)];
-  }
-};
-
-AccelOperator accel_operator(std::size_t n, double dt, const derivatives::Params& params) {
-  AccelOperator op;
-  op.n = n;
-  std::vector<double> impulse(n, 0.0);
-  const std::size_t mid = n / 2;
-  impulse[mid] = 1.0;
-  const derivatives::Result probe = derivatives::differentiate(impulse, dt, params);
-  double peak = 0.0;
-  for (const double v : probe.acc) peak = std::max(peak, std::abs(v));
-  for (std::size_t k = 0; k < n; ++k) {
-    if (std::abs(probe.acc[k]) > kBandThreshold * peak) op.band = std::max(op.band, k > mid ? k - mid : mid - k);
-  }
-  op.band = std::min(op.band, n - 1);
-  const std::size_t w = 2 * op.band + 1;
-  op.coef.assign(n * w, 0.0);
-  for (std::size_t j = 0; j < n; ++j) {
-    impulse.assign(n, 0.0);
-    impulse[j] = 1.0;
-    const derivatives::Result col = derivatives::differentiate(impulse, dt, params);
-    for (std::size_t k = (j > op.band ? j - op.band : 0); k < std::min(n, j + op.band + 1); ++k) {
-      op.coef[j * w + (k + op.band - j)] = col.acc[k];
-    }
-  }
-  return op;
-}
-
 // d zmp / d (segment position) and d zmp / d (segment acceleration), 2 x 3 each,
 // from p = M / N (zmp.hpp), at one frame.
 struct ZmpPartials {
@@ -152,7 +111,7 @@ FilterResult balance_filter(const HumanMotion& motion, const FilterOptions& o, F
   std::vector<bool> unreachable(n, false);
   const double tol = o.analysis.tolerance_m;
   const std::size_t m = n - first;
-  const AccelOperator op = accel_operator(m, dt, o.analysis.derivatives);
+  const AccelOperator op = detail::accel_operator(m, dt, o.analysis.derivatives);
   r.operator_band = op.band;
   std::vector<double> weight(n, 1.0);  // grows for frames that stay outside (penalty continuation)
   double damping = 1e-6;               // Levenberg-Marquardt
