@@ -62,7 +62,7 @@ struct IkOptions {
   // that straightens the stance leg jerks the knee; soft, the heel rises a
   // little instead. Standing still it fades out (over stride_soft_fade_s), so
   // a standing leg is straight and its foot exactly on the floor.
-  double stride_softness_m = 0.02;
+  double stride_softness_m = 0.03;
   double stride_soft_speed_mps = 0.3;
   double stride_soft_fade_s = 0.2;
   double elbow_smoothing_s = 0.05;  // time constant of the elbows' pole (0: none)
@@ -72,7 +72,7 @@ struct IkOptions {
   double step_turn_rad = 0.6;      // ... or turned further than this from the pelvis's heading
   double step_time_s = 0.45;       // one step's swing at standing pace
   double step_time_min_s = 0.3;    // when walking fast
-  double step_lift_m = 0.08;       // swing height
+  double step_lift_m = 0.05;       // swing height (the arc is much of a swing's jerk)
   // A foot lands this far ahead of the moving pelvis. Half a stance (about
   // 0.33 s) would make a walk's stride, but 3 points do not say which foot
   // stands, and a stride in the wrong phase is a step length off: shorter
