@@ -495,8 +495,15 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     // the pelvis's.
     const Vec3 foot_fwd = horizontal(target.rot * Vec3::UnitX()) + horizontal(target.rot * Vec3::UnitZ());
     const Vec3 pelvis_fwd = horizontal(w.f.rot[0] * Vec3::UnitX());
-    const Vec3 raw_knee = (foot_fwd.norm() > 1e-6 ? Vec3(foot_fwd.normalized()) : Vec3::Zero()) +
-                          kPelvisKneeWeight * (pelvis_fwd.norm() > 1e-6 ? Vec3(pelvis_fwd.normalized()) : Vec3::Zero());
+    Vec3 raw_knee = (foot_fwd.norm() > 1e-6 ? Vec3(foot_fwd.normalized()) : Vec3::Zero()) +
+                    kPelvisKneeWeight * (pelvis_fwd.norm() > 1e-6 ? Vec3(pelvis_fwd.normalized()) : Vec3::Zero());
+    // A tracked foot also names the knee's axis: its own left axis (an ankle
+    // pitches about it and barely twists), so the knee goes across the leg
+    // from it. The facing alone flips with a running foot's pitch.
+    if (m.calibration.offset[index(kFootTracker[s])].valid && ft.seen) {
+      const Vec3 leg = target.pos_m - hip[s];
+      if (leg.norm() > 1e-6) raw_knee += leg.normalized().cross(target.rot * m.hinge_axis[bi(shank)]);
+    }
     // Smoothed as the elbows' (a foot's quick turns are the ankle's).
     smooth_pole(st.knee_pole[s], raw_knee, body_yaw * Vec3::UnitX(), !st.started,
                 detail::first_order_share(dt, o.knee_smoothing_s));
