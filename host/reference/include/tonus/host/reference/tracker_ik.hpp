@@ -48,6 +48,7 @@ struct IkOptions {
   double chest_share = 0.25;
   double neck_share = 0.6;
   double hands_heading_weight = 0.3;  // the hands' say in the body's heading, against the head's 1
+  double heading_smoothing_s = 0.02;  // time constant of that heading, 3 points (0: none)
   double trunk_smoothing_s = 0.05;    // time constant of the head turn the trunk bones share (0: none)
   double trunk_follows_pelvis = 0.5;  // 6 points: the share of the waist tracker's turn the spine and chest take
   // Arms.
