@@ -40,6 +40,7 @@ constexpr int kElbowBisections = 10;  // to 0.03 degrees
 constexpr double kReachedTolerance_m = 1e-3;
 constexpr double kPelvisKneeWeight = 0.5;
 constexpr double kTwistMargin_rad = 0.05;
+constexpr double kElbowStayBend = 0.4;  // of the arm's reach: the wrist this much nearer, the elbow keeps fully
 
 // max(a, b) with the corner rounded over `soft`: never below either.
 double smooth_max(double a, double b, double soft) {
@@ -146,7 +147,7 @@ IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calib
   const bool shares_ok = o.pelvis_share >= 0.0 && o.spine_share >= 0.0 && o.chest_share >= 0.0 && o.neck_share >= 0.0 &&
                          o.pelvis_share <= 1.0 && o.spine_share <= 1.0 && o.chest_share <= 1.0 && o.neck_share <= 1.0 &&
                          o.hands_heading_weight >= 0.0 && o.clavicle_share >= 0.0 && o.clavicle_raise_share >= 0.0 &&
-                         o.default_pole_weight >= 0.0;
+                         o.default_pole_weight >= 0.0 && o.elbow_stay_weight >= 0.0;
   if (!(times_ok && sizes_ok && shares_ok)) {
     c.error = "tracker IK: an option is out of range (times and lengths must be positive, shares in [0, 1])";
     return c;
@@ -394,6 +395,14 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     smooth_pole(st.elbow_pole[s], raw_pole, chest.conjugate() * anatomic.normalized(), !st.started,
                 detail::first_order_share(dt, o.elbow_smoothing_s));
     Vec3 pole = chest * st.elbow_pole[s];
+    // A bent arm's elbow also keeps to where it was: a waving forearm turns
+    // about a still elbow, which the hand's cue alone swings around. Nearly
+    // straight, the elbow's side says little and the hand's cue leads.
+    const Vec3 last = across_line(chest * st.elbow_last[s]);
+    if (st.started && last.norm() > 1e-6) {
+      const double bent = std::clamp((reach - line.norm()) / (kElbowStayBend * reach), 0.0, 1.0);
+      pole = pole.normalized() + o.elbow_stay_weight * bent * last.normalized();
+    }
     IkState::Track& et = st.track[index(kElbow[s])];
     if (m.calibration.offset[index(kElbow[s])].valid && et.seen) {
       const TrackerPose e = detail::effective_pose(TrackerPose{shoulder + pole, Quat::Identity(), true}, dt, o, et,
@@ -444,6 +453,7 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
         sol = detail::solve_two_bone(limb, shoulder, target.pos_m, pole, anatomic);
       }
     }
+    st.elbow_last[s] = chest.conjugate() * (sol.upper * m.rest_dir[bi(upper)]);
     w.f.pos[bi(upper)] = shoulder;
     double angle = sol.hinge_rad;
     if (settle_ball(m, w, upper, sol.upper)) {

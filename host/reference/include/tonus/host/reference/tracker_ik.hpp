@@ -55,6 +55,7 @@ struct IkOptions {
   double clavicle_share = 0.08;        // of the swing that would point the clavicle at the hand
   double clavicle_raise_share = 0.25;  // added in proportion to how far above the shoulder the hand is
   double default_pole_weight = 0.25;   // elbows: the anatomical pole (down, back) against the hand's
+  double elbow_stay_weight = 3.0;      // a bent arm's elbow kept on its last side, against the smoothed cue's 1
   double arm_softness_m = 0.002;       // soft reach near a straight arm (the wrist short by at most 0.37 of it)
   double leg_softness_m = 0.0;         // ... and leg, always (0: a standing leg straight, its foot on the floor)
   // Procedural feet (3 points) only: a soft reach that fades in with the
@@ -173,6 +174,7 @@ struct IkState {
   double body_yaw_rad = 0.0;
   sim::Quat trunk_turn = sim::Quat::Identity();  // the head's turn from the heading, smoothed
   std::array<sim::Vec3, 2> elbow_pole{};         // in the chest's frame, smoothed, unit
+  std::array<sim::Vec3, 2> elbow_last{};         // the last solved upper arm's direction, chest's frame
   std::array<sim::Vec3, 2> knee_pole{};          // in the world, smoothed, unit
   sim::Vec3 last_pelvis = sim::Vec3::Zero();
   sim::Vec3 pelvis_velocity = sim::Vec3::Zero();
