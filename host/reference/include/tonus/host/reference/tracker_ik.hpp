@@ -73,7 +73,7 @@ struct IkOptions {
   double step_threshold_m = 0.12;  // a planted foot further than this from its place under the hip steps
   double step_turn_rad = 0.6;      // ... or turned further than this from the pelvis's heading
   double step_time_s = 0.45;       // one step's swing at standing pace
-  double step_time_min_s = 0.3;    // when walking fast
+  double step_time_min_s = 0.38;   // when walking fast (a swing takes about 0.4 s at any pace)
   double step_lift_m = 0.05;       // swing height (the arc is much of a swing's jerk)
   // A foot lands this far ahead of the moving pelvis. Half a stance (about
   // 0.33 s) would make a walk's stride, but 3 points do not say which foot
