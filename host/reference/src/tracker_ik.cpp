@@ -145,7 +145,9 @@ IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calib
                         o.implausible_reach_factor > 1.0 && o.leg_softness_m >= 0.0 && o.stride_softness_m >= 0.0 &&
                         o.stride_soft_speed_mps > 0.0;
   const bool shares_ok = o.pelvis_share >= 0.0 && o.spine_share >= 0.0 && o.chest_share >= 0.0 && o.neck_share >= 0.0 &&
-                         o.pelvis_share <= 1.0 && o.spine_share <= 1.0 && o.chest_share <= 1.0 && o.neck_share <= 1.0 &&
+                         o.pelvis_share <= 1.0 && o.spine_share <= 1.0 && o.trunk_follows_pelvis >= 0.0 &&
+                         o.trunk_follows_pelvis <= 1.0 && o.trunk_tilts_with_pelvis >= 0.0 &&
+                         o.trunk_tilts_with_pelvis <= 1.0 && o.chest_share <= 1.0 && o.neck_share <= 1.0 &&
                          o.hands_heading_weight >= 0.0 && o.clavicle_share >= 0.0 && o.clavicle_raise_share >= 0.0 &&
                          o.default_pole_weight >= 0.0 && o.elbow_stay_weight >= 0.0;
   if (!(times_ok && sizes_ok && shares_ok)) {
@@ -292,9 +294,16 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     w.f.rot[0] = hips.rot;
     // Start from the 3-point trunk's shape, carried to the new pelvis and
     // turned with it by a share: the thorax turns against the pelvis in a
-    // walk, so carrying it whole passes the pelvis's sway up the spine.
-    const Quat carry =
-        Quat::Identity().slerp(o.trunk_follows_pelvis, (hips.rot * share(o.pelvis_share).conjugate()).normalized());
+    // walk, so carrying it whole passes the pelvis's sway up the spine. The
+    // pelvis's tilt and roll (its swing off the vertical) shake the chest
+    // more than its turn does, so they are shared apart.
+    const Quat rel = (hips.rot * share(o.pelvis_share).conjugate()).normalized();
+    Quat turn_z(rel.w(), 0.0, 0.0, rel.z());
+    turn_z = turn_z.norm() > 1e-9 ? turn_z.normalized() : Quat::Identity();
+    const Quat tilt = (rel * turn_z.conjugate()).normalized();
+    const Quat carry = (Quat::Identity().slerp(o.trunk_tilts_with_pelvis, tilt) *
+                        Quat::Identity().slerp(o.trunk_follows_pelvis, turn_z))
+                           .normalized();
     const Quat spine = (carry * w.f.rot[bi(Bone::Spine)]).normalized();
     const Quat chest = (carry * w.f.rot[bi(Bone::Chest)]).normalized();
     const Vec3 base = hips.pos_m + hips.rot * m.offset[bi(Bone::Spine)];
