@@ -60,6 +60,18 @@ std::span<const double> joint_values(const Clip& clip, std::size_t frame, std::s
       .subspan(frame * n + first_column(clip, joint), clip.joints[joint].channels.size());
 }
 
+// Where a joint's three rotation channels sit in a frame row, in channel
+// order (the joint must have a rotation_order).
+std::array<std::size_t, 3> rotation_columns(const Clip& clip, std::size_t joint) {
+  const Joint& target = clip.joints[joint];
+  std::array<std::size_t, 3> columns{};
+  std::size_t k = 0;
+  for (std::size_t c = 0; c < target.channels.size(); ++c) {
+    if (is_rotation(target.channels[c])) columns.at(k++) = first_column(clip, joint) + c;
+  }
+  return columns;
+}
+
 }  // namespace
 
 bool forward_kinematics(const Clip& clip, std::size_t frame, std::vector<JointPose>& out) {
@@ -129,12 +141,8 @@ bool set_local_rotation(Clip& clip, std::size_t frame, std::size_t joint, const 
   const Joint& target = clip.joints[joint];
   const std::optional<EulerOrder> order = rotation_order(target);
   if (!order) return false;
-  const std::size_t base = frame * clip.channel_count() + first_column(clip, joint);
-  std::array<std::size_t, 3> columns{};
-  std::size_t k = 0;
-  for (std::size_t c = 0; c < target.channels.size(); ++c) {
-    if (is_rotation(target.channels[c])) columns.at(k++) = base + c;
-  }
+  std::array<std::size_t, 3> columns = rotation_columns(clip, joint);
+  for (std::size_t& c : columns) c += frame * clip.channel_count();
   const EulerAngles now{clip.values[columns[0]], clip.values[columns[1]], clip.values[columns[2]]};
   const EulerAngles angles = euler_from_quaternion_near(q, *order, now);
   for (std::size_t i = 0; i < 3; ++i) clip.values[columns.at(i)] = angles.at(i);
@@ -146,15 +154,10 @@ bool unwrap_rotation(Clip& clip, std::size_t joint, std::size_t from_frame) {
       from_frame >= clip.frame_count) {
     return false;
   }
-  const Joint& target = clip.joints[joint];
-  const std::optional<EulerOrder> order = rotation_order(target);
+  const std::optional<EulerOrder> order = rotation_order(clip.joints[joint]);
   if (!order) return false;
   const std::size_t n = clip.channel_count();
-  std::array<std::size_t, 3> columns{};
-  std::size_t k = 0;
-  for (std::size_t c = 0; c < target.channels.size(); ++c) {
-    if (is_rotation(target.channels[c])) columns.at(k++) = first_column(clip, joint) + c;
-  }
+  const std::array<std::size_t, 3> columns = rotation_columns(clip, joint);
   const auto angles_at = [&](std::size_t f) {
     const std::size_t row = f * n;
     return EulerAngles{clip.values[row + columns[0]], clip.values[row + columns[1]], clip.values[row + columns[2]]};
