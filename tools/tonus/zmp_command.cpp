@@ -158,11 +158,7 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
   report.frame_time_s = read.clip.frame_time_s;
   report.frames_total = read.clip.frame_count;
   report.filter = &result;
-  report.max_foot_displacement_m = applied.max_foot_displacement_m;
-  report.rms_change_changed_joints_rad = applied.rms_change_changed_joints_rad;
-  report.changed_samples = applied.changed_samples;
-  report.largest_change = applied.largest_change;
-  report.rms_change_all_mapped_joints_rad = applied.rms_change_all_mapped_joints_rad;
+  report.applied = &applied;
   for (const balance::Vec3& d : result.correction)
     report.max_correction_rad = std::max(report.max_correction_rad, d.norm());
   report.lookahead_frames = result.operator_band;
@@ -191,10 +187,10 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
     fmt::print("  after:  ZMP outside the support polygon in {} of {} frames (max {:.3f} m), {} unsolved\n",
                a.frames_outside, a.frames, a.max_outside_m, result.frames_unsolved);
     fmt::print("  correction: waist rotation up to {:.3f} rad, feet moved by at most {:.2e} m, {} iterations\n",
-               report.max_correction_rad, report.max_foot_displacement_m, result.iterations);
+               report.max_correction_rad, applied.max_foot_displacement_m, result.iterations);
     // Only the joints and frames changed count, so the figure is the edit's real size.
     std::string largest;
-    for (const balance::JointChange& c : report.largest_change) {
+    for (const balance::JointChange& c : applied.largest_change) {
       largest += fmt::format("{}{} {:.3f}{} (frame {})", largest.empty() ? "" : ", ", c.joint, c.max_rad,
                              largest.empty() ? " rad" : "", c.frame);
     }
@@ -204,7 +200,7 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
       fmt::print(
           "  joint change: RMS change over changed joints {:.4f} rad ({} joints, {} joint-frames), largest per "
           "joint: {}\n",
-          report.rms_change_changed_joints_rad, report.largest_change.size(), report.changed_samples, largest);
+          applied.rms_change_changed_joints_rad, applied.largest_change.size(), applied.changed_samples, largest);
     }
     if (result.frames_unsolved > 0) {
       std::string list;

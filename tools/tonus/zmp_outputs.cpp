@@ -101,19 +101,20 @@ bool write_zmp_json(const std::string& path, const ZmpReport& r, std::string& er
                      a.max_outside_m);
   out += fmt::format("  \"rms_outside_before_m\": {:.6f},\n  \"rms_outside_after_m\": {:.6f},\n", b.rms_outside_m,
                      a.rms_outside_m);
-  out += fmt::format("  \"max_foot_displacement_m\": {:.9f},\n", r.max_foot_displacement_m);
+  const balance::AppliedCorrection& w = *r.applied;
+  out += fmt::format("  \"max_foot_displacement_m\": {:.9f},\n", w.max_foot_displacement_m);
   // rms_joint_change_rad is the older all-mapped-joints figure, kept for existing readers.
-  out += fmt::format("  \"rms_joint_change_rad\": {:.6f},\n", r.rms_change_all_mapped_joints_rad);
-  out += fmt::format("  \"rms_change_changed_joints_rad\": {:.6f},\n", r.rms_change_changed_joints_rad);
-  out += fmt::format("  \"changed_joints\": {},\n  \"changed_joint_frames\": {},\n", r.largest_change.size(),
-                     r.changed_samples);
+  out += fmt::format("  \"rms_joint_change_rad\": {:.6f},\n", w.rms_change_all_mapped_joints_rad);
+  out += fmt::format("  \"rms_change_changed_joints_rad\": {:.6f},\n", w.rms_change_changed_joints_rad);
+  out += fmt::format("  \"changed_joints\": {},\n  \"changed_joint_frames\": {},\n", w.largest_change.size(),
+                     w.changed_samples);
   out += "  \"max_change_per_joint\": {";
-  for (std::size_t i = 0; i < r.largest_change.size(); ++i) {
-    const balance::JointChange& c = r.largest_change[i];
+  for (std::size_t i = 0; i < w.largest_change.size(); ++i) {
+    const balance::JointChange& c = w.largest_change[i];
     out += fmt::format("{}\n    {}: {{\"bone\": {}, \"max_rad\": {:.6f}, \"frame\": {}}}", i == 0 ? "" : ",",
                        json_string(c.joint), json_string(c.bone), c.max_rad, c.frame);
   }
-  out += r.largest_change.empty() ? "},\n" : "\n  },\n";
+  out += w.largest_change.empty() ? "},\n" : "\n  },\n";
   out += fmt::format("  \"max_correction_rad\": {:.6f},\n", r.max_correction_rad);
   out += fmt::format("  \"frames_unsolved\": {},\n", f.frames_unsolved);
   out += fmt::format("  \"frames_airborne\": {},\n", b.frames_airborne);

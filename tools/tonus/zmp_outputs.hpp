@@ -1,7 +1,6 @@
 // The balance report's files: CSV per frame, a JSON report, an SVG plot.
 #pragma once
 
-#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -19,11 +18,7 @@ struct ZmpReport {
   double frame_time_s = 0.0;
   std::size_t frames_total = 0;
   const balance::FilterResult* filter = nullptr;
-  double max_foot_displacement_m = 0.0;  // measured on the written clip
-  double rms_change_changed_joints_rad = 0.0;
-  std::size_t changed_samples = 0;
-  std::vector<balance::JointChange> largest_change;
-  double rms_change_all_mapped_joints_rad = 0.0;  // the older figure, untouched joints included
+  const balance::AppliedCorrection* applied = nullptr;  // the written clip, measured against the original
   double max_correction_rad = 0.0;
   std::size_t lookahead_frames = 0;
   balance::Vec2 forward = balance::Vec2::UnitX();  // the plots' forward axis in the ground plane
