@@ -298,8 +298,7 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     // pelvis's tilt and roll (its swing off the vertical) shake the chest
     // more than its turn does, so they are shared apart.
     const Quat rel = (hips.rot * share(o.pelvis_share).conjugate()).normalized();
-    Quat turn_z(rel.w(), 0.0, 0.0, rel.z());
-    turn_z = turn_z.norm() > 1e-9 ? turn_z.normalized() : Quat::Identity();
+    const Quat turn_z(Eigen::AngleAxisd(sim::swing_twist(rel, Vec3::UnitZ()).twist_rad, Vec3::UnitZ()));
     const Quat tilt = (rel * turn_z.conjugate()).normalized();
     const Quat carry = (Quat::Identity().slerp(o.trunk_tilts_with_pelvis, tilt) *
                         Quat::Identity().slerp(o.trunk_follows_pelvis, turn_z))
