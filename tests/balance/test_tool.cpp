@@ -67,6 +67,33 @@ TEST_CASE("tonus zmp: corrects the bundled walk and writes BVH, CSV, JSON and SV
   CHECK(read_file(temp("again.json")).find("\"frames_outside_before\": 0,") != std::string::npos);
 }
 
+TEST_CASE("tonus zmp: every report gives the verdict of each estimator of the family") {
+  const std::string clip = std::string(TONUS_SOURCE_DIR) + "/tests/data/cmu_02_walk.bvh";
+  const Run r = run(clip + " --json " + temp("family.json"));
+  INFO(r.out);
+  CHECK(r.out.find("under each estimator (frames outside by more than 1 cm") != std::string::npos);
+  CHECK(r.out.find("12 Hz full ") != std::string::npos);
+  // The waist rotation is balanced under its own estimator only.
+  CHECK(r.out.find("NOT balanced under every estimator") != std::string::npos);
+  const std::string json = read_file(temp("family.json"));
+  for (const char* key :
+       {"\"estimators\": [", "\"cutoff_hz\": 4, \"form\": \"particle\"", "\"cutoff_hz\": 12, \"form\": \"full\"",
+        "\"balanced_under_every_estimator\": false", "\"worst_estimator_share_outside_after\""}) {
+    CHECK_MESSAGE(json.find(key) != std::string::npos, key);
+  }
+}
+
+TEST_CASE("tonus zmp --correction waist: lean, yaw and pelvis shift, balanced under every estimator") {
+  const std::string clip = std::string(TONUS_SHARED_DATA_DIR) + "/bvh/dataset-1_walk_normal_001.bvh";
+  const Run r = run(clip + " --correction waist -o " + temp("waist.bvh") + " --json " + temp("waist.json"));
+  INFO(r.out);
+  CHECK(r.code == 0);
+  CHECK(r.out.find("correction: lean up to ") != std::string::npos);
+  CHECK(r.out.find("balanced (at most 2 %)") != std::string::npos);
+  CHECK(read_file(temp("waist.json")).find("\"balanced_under_every_estimator\": true") != std::string::npos);
+  CHECK(run(clip + " --correction sideways").code != 0);
+}
+
 TEST_CASE("tonus zmp: bad input is refused with exit code 2 and a reason") {
   const Run missing = run(temp("no_such_file.bvh"));
   CHECK(missing.code == 2);

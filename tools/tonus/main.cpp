@@ -68,7 +68,11 @@ int run(int argc, char** argv) {
   zmp_cmd->add_option("--derivative", zmp.derivative, "kalman_spline (default), kalman, spline or finite_difference");
   zmp_cmd->add_option("--cutoff", zmp.cutoff_hz, "Smoothing cutoff, Hz")->check(CLI::Range(0.5, 100.0));
   zmp_cmd->add_flag("--full-zmp", zmp.full_zmp, "Include the segments' angular momentum (default: particle form)");
-  zmp_cmd->add_option("--correction", zmp.correction, "Correction method: rotation (the waist rotation)");
+  zmp_cmd
+      ->add_option("--correction", zmp.correction,
+                   "Correction: rotation (the waist rotation, under one estimator) or waist (lean, yaw and pelvis "
+                   "shift, robust under the estimator family)")
+      ->check(CLI::IsMember({"rotation", "waist"}));
   zmp_cmd->add_option("--margin", zmp.margin_m, "Aim this far inside the support polygon, m")
       ->check(CLI::Range(0.0, 0.05));
   zmp_cmd->add_option("--max-correction", zmp.max_correction_rad, "Largest waist rotation per frame, rad")

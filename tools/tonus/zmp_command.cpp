@@ -10,7 +10,9 @@
 
 #include "tonus/host/balance/apply.hpp"
 #include "tonus/host/balance/convert.hpp"
+#include "tonus/host/balance/family.hpp"
 #include "tonus/host/balance/filter.hpp"
+#include "tonus/host/balance/robust_filter.hpp"
 #include "tonus/host/motion/bvh.hpp"
 #include "tonus/sim/human_bones.hpp"
 #include "zmp_outputs.hpp"
@@ -65,6 +67,49 @@ void on_progress(int iteration, std::size_t outside, void* user) {
   std::fflush(stderr);
 }
 
+// One line per member: frames outside by more than the threshold, before -> after.
+void print_family(const balance::FamilyVerdict& before, const balance::FamilyVerdict& after) {
+  if (after.members.empty()) return;
+  fmt::print("  under each estimator (frames outside by more than {:.0f} cm, before -> after, of {} supported):\n",
+             100.0 * after.threshold_m, after.members[after.worst].supported);
+  std::string line;
+  for (std::size_t i = 0; i < after.members.size() && i < before.members.size(); ++i) {
+    const balance::MemberVerdict& a = after.members[i];
+    line += fmt::format("{}{:g} Hz {} {} -> {}", i % 2 == 0 ? "    " : ", ", a.cutoff_hz, a.full ? "full" : "particle",
+                        before.members[i].outside, a.outside);
+    if (i % 2 == 1) {
+      fmt::print("{}\n", line);
+      line.clear();
+    }
+  }
+  if (!line.empty()) fmt::print("{}\n", line);
+  const balance::MemberVerdict& w = after.members[after.worst];
+  fmt::print("  worst estimator after: {:g} Hz {}, {} frames ({:.1f} %): {} (at most {:.0f} %)\n", w.cutoff_hz,
+             w.full ? "full" : "particle", w.outside, 100.0 * w.share(),
+             after.balanced() ? "balanced" : "NOT balanced under every estimator",
+             100.0 * balance::kFamilyAllowedShare);
+}
+
+// The robust filter's result in the report's shape: its figures under the
+// base estimator (the family's verdict is reported beside).
+balance::FilterResult as_filter_result(balance::RobustFilterResult&& r, const balance::HumanMotion& original,
+                                       const balance::AnalysisOptions& base) {
+  balance::FilterResult f;
+  const balance::ContactTrack& contacts = r.before.front().contacts;
+  f.before = balance::analyse(original, base, &contacts);
+  f.after = balance::analyse(r.corrected, base, &contacts);
+  f.corrected = std::move(r.corrected);
+  f.correction = std::move(r.rotation);
+  f.shift_m = std::move(r.shift_m);
+  f.unsolved = std::move(r.unsolved);
+  f.frames_unsolved = r.frames_unsolved;
+  f.max_foot_displacement_m = r.max_foot_displacement_m;
+  f.max_drop_m = r.max_drop_m;
+  f.iterations = r.iterations;
+  f.operator_band = r.lookahead_frames;
+  return f;
+}
+
 }  // namespace
 
 int run_zmp_command(const ZmpCommandOptions& opt) {
@@ -115,7 +160,7 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
   ao.contacts.speed_off_mps = 2.0 * opt.contact_speed_mps;
   ao.contacts.foot_length_m = opt.foot_length_m;
   ao.contacts.ground_z_m = opt.ground_height_m;
-  if (opt.correction != "rotation") return fail("--correction: only 'rotation' (the waist rotation) is offered");
+  if (opt.correction != "rotation" && opt.correction != "waist") return fail("--correction: rotation or waist");
   fo.margin_m = opt.margin_m;
   fo.max_correction_rad = opt.max_correction_rad;
   fo.max_iterations = opt.max_iterations;
@@ -136,12 +181,26 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
     for (const auto& w : read.warnings) fmt::print("  warning (line {}): {}\n", w.line, w.message);
   }
   Progress progress{!opt.quiet && (isatty(STDERR_FILENO) != 0 || conv.motion.size() > 1000)};
-  const balance::FilterResult result = balance::balance_filter(conv.motion, fo, on_progress, &progress);
-  if (progress.show) fmt::print(stderr, "\n");
+  balance::FilterResult result;
+  std::vector<balance::Vec2> shift_m;
+  if (opt.correction == "waist") {
+    balance::RobustFilterOptions ro;
+    ro.analysis = ao;
+    ro.margin_m = opt.margin_m;
+    ro.max_iterations = opt.max_iterations;
+    balance::RobustFilterResult robust = balance::robust_balance_filter(conv.motion, ro, on_progress, &progress);
+    if (progress.show) fmt::print(stderr, "\n");
+    if (!robust.ok()) return fail(robust.error);
+    result = as_filter_result(std::move(robust), conv.motion, ao);
+    shift_m = std::move(result.shift_m);
+  } else {
+    result = balance::balance_filter(conv.motion, fo, on_progress, &progress);
+    if (progress.show) fmt::print(stderr, "\n");
+  }
   if (!result.ok()) return fail(result.error);
 
   balance::AppliedCorrection applied =
-      balance::apply_correction(read.clip, conv.geometry, conv.motion, result.correction);
+      balance::apply_correction(read.clip, conv.geometry, conv.motion, result.correction, shift_m);
   if (!applied.ok()) return fail(applied.error);
   if (!opt.output.empty()) {
     std::ofstream out(opt.output, std::ios::binary);
@@ -149,7 +208,20 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
     if (!out) return fail("cannot write " + opt.output);
   }
 
+  // The original and the written clip, read back as a user would, under every
+  // estimator of the family: the filter's own figures are one member's.
+  const std::vector<balance::AnalysisOptions> members = balance::estimator_family(ao);
+  const balance::FamilyVerdict family_before =
+      balance::family_verdict(balance::analyse_family(conv.motion, members, result.before.contacts), members);
+  const balance::Conversion written = balance::convert_motion(applied.clip, mapping, convert);
+  if (!written.ok()) return fail("re-reading the corrected clip: " + written.error);
+  const balance::ContactTrack written_contacts = balance::detect_contacts(written.motion, ao.contacts);
+  const balance::FamilyVerdict family_after =
+      balance::family_verdict(balance::analyse_family(written.motion, members, written_contacts), members);
+
   ZmpReport report;
+  report.family_before = &family_before;
+  report.family_after = &family_after;
   report.input = opt.input;
   report.convention = mapping.map.convention;
   report.unit = conv.unit_name;
@@ -186,8 +258,21 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
                b.frames_outside, b.frames, b.max_outside_m, b.rms_outside_m);
     fmt::print("  after:  ZMP outside the support polygon in {} of {} frames (max {:.3f} m), {} unsolved\n",
                a.frames_outside, a.frames, a.max_outside_m, result.frames_unsolved);
-    fmt::print("  correction: waist rotation up to {:.3f} rad, feet moved by at most {:.2e} m, {} iterations\n",
-               report.max_correction_rad, applied.max_foot_displacement_m, result.iterations);
+    if (shift_m.empty()) {
+      fmt::print("  correction: waist rotation up to {:.3f} rad, feet moved by at most {:.2e} m, {} iterations\n",
+                 report.max_correction_rad, applied.max_foot_displacement_m, result.iterations);
+    } else {
+      double lean = 0.0, yaw = 0.0, shift = 0.0;
+      for (std::size_t t = 0; t < shift_m.size(); ++t) {
+        lean = std::max(lean, result.correction[t].head<2>().norm());
+        yaw = std::max(yaw, std::abs(result.correction[t].z()));
+        shift = std::max(shift, shift_m[t].norm());
+      }
+      fmt::print(
+          "  correction: lean up to {:.1f} deg, yaw up to {:.1f} deg, pelvis shift up to {:.1f} cm; feet moved by at "
+          "most {:.2e} m, {} iterations\n",
+          lean * 180.0 / M_PI, yaw * 180.0 / M_PI, 100.0 * shift, applied.max_foot_displacement_m, result.iterations);
+    }
     // Only the joints and frames changed count, so the figure is the edit's real size.
     std::string largest;
     for (const balance::JointChange& c : applied.largest_change) {
@@ -202,6 +287,7 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
           "joint: {}\n",
           applied.rms_change_changed_joints_rad, applied.largest_change.size(), applied.changed_samples, largest);
     }
+    print_family(family_before, family_after);
     if (result.frames_unsolved > 0) {
       std::string list;
       std::size_t shown = 0;
@@ -209,11 +295,20 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
         if (!result.unsolved[t]) continue;
         list += (shown++ > 0 ? ", " : "") + std::to_string(t);
       }
-      fmt::print("  unsolved frames (no correction within {:.2f} rad, or a leg out of reach): {}{}\n",
-                 opt.max_correction_rad, list, result.frames_unsolved > shown ? ", ..." : "");
+      if (shift_m.empty()) {
+        fmt::print("  unsolved frames (no correction within {:.2f} rad, or a leg out of reach): {}{}\n",
+                   opt.max_correction_rad, list, result.frames_unsolved > shown ? ", ..." : "");
+      } else {
+        fmt::print("  frames outside by more than {:.0f} cm under some estimator: {}{}\n",
+                   100.0 * balance::kFamilyThreshold_m, list, result.frames_unsolved > shown ? ", ..." : "");
+      }
     }
     if (!opt.output.empty()) fmt::print("  written: {}\n", opt.output);
   }
+  // The waist correction answers to the family: a few frames outside under
+  // some member are allowed (kFamilyAllowedShare), a clip that is not
+  // balanced under every member is not.
+  if (!shift_m.empty()) return family_after.balanced() ? 0 : 1;
   return result.frames_unsolved == 0 ? 0 : 1;
 }
 

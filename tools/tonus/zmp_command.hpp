@@ -27,7 +27,7 @@ struct ZmpCommandOptions {
   std::string derivative = "kalman_spline";  // kalman_spline, kalman, spline, finite_difference
   double cutoff_hz = 6.0;
   bool full_zmp = false;                // include the segments' angular momentum rate
-  std::string correction = "rotation";  // the only method: waist rotation
+  std::string correction = "rotation";  // rotation (waist rotation, one estimator) or waist (robust filter)
   double margin_m = 0.01;
   double max_correction_rad = 1.0;
   int max_iterations = 100;
@@ -36,7 +36,9 @@ struct ZmpCommandOptions {
 };
 
 // Process exit code: 0 when every analysed frame ends inside its support
-// polygon (or airborne), 1 when frames remain unsolved, 2 on bad input.
+// polygon (or airborne) (--correction waist: when the written clip is
+// balanced under every estimator of the family), 1 when frames remain
+// unsolved (not balanced), 2 on bad input.
 int run_zmp_command(const ZmpCommandOptions& options);
 
 }  // namespace tonus::tools

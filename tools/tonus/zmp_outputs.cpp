@@ -84,6 +84,27 @@ bool write_zmp_csv(const std::string& path, const ZmpReport& r, std::string& err
   return write_file(path, out, error);
 }
 
+// Each member's verdict before and after, and the worst one's share after.
+std::string family_json(const balance::FamilyVerdict* before, const balance::FamilyVerdict* after) {
+  if (before == nullptr || after == nullptr) return "  \"estimators\": []\n";
+  std::string out = fmt::format("  \"estimator_threshold_m\": {:.3f},\n", after->threshold_m);
+  out += "  \"estimators\": [";
+  for (std::size_t i = 0; i < after->members.size() && i < before->members.size(); ++i) {
+    const balance::MemberVerdict& b = before->members[i];
+    const balance::MemberVerdict& a = after->members[i];
+    out += fmt::format(
+        "{}\n    {{\"cutoff_hz\": {}, \"form\": \"{}\", \"supported_frames\": {}, \"outside_before\": {}, "
+        "\"outside_after\": {}, \"max_outside_before_m\": {:.6f}, \"max_outside_after_m\": {:.6f}}}",
+        i == 0 ? "" : ",", a.cutoff_hz, a.full ? "full" : "particle", a.supported, b.outside, a.outside,
+        b.max_outside_m, a.max_outside_m);
+  }
+  out += after->members.empty() ? "],\n" : "\n  ],\n";
+  const double worst = after->members.empty() ? 0.0 : after->members[after->worst].share();
+  out += fmt::format("  \"worst_estimator_share_outside_after\": {:.6f},\n", worst);
+  out += fmt::format("  \"balanced_under_every_estimator\": {}\n", after->balanced());
+  return out;
+}
+
 bool write_zmp_json(const std::string& path, const ZmpReport& r, std::string& error) {
   const balance::FilterResult& f = *r.filter;
   const balance::AnalysisSummary& b = f.before.summary;
@@ -120,7 +141,8 @@ bool write_zmp_json(const std::string& path, const ZmpReport& r, std::string& er
   out += fmt::format("  \"frames_airborne\": {},\n", b.frames_airborne);
   out += fmt::format("  \"frames_zmp_undefined\": {},\n", b.frames_undefined);
   out += fmt::format("  \"iterations\": {},\n", f.iterations);
-  out += fmt::format("  \"lookahead_frames\": {}\n", r.lookahead_frames);
+  out += fmt::format("  \"lookahead_frames\": {},\n", r.lookahead_frames);
+  out += family_json(r.family_before, r.family_after);
   out += "}\n";
   return write_file(path, out, error);
 }

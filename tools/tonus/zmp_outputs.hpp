@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "tonus/host/balance/apply.hpp"
+#include "tonus/host/balance/family.hpp"
 #include "tonus/host/balance/filter.hpp"
 
 namespace tonus::tools {
@@ -19,6 +20,9 @@ struct ZmpReport {
   std::size_t frames_total = 0;
   const balance::FilterResult* filter = nullptr;
   const balance::AppliedCorrection* applied = nullptr;  // the written clip, measured against the original
+  // The original and the written clip under every estimator of the family.
+  const balance::FamilyVerdict* family_before = nullptr;
+  const balance::FamilyVerdict* family_after = nullptr;
   double max_correction_rad = 0.0;
   std::size_t lookahead_frames = 0;
   balance::Vec2 forward = balance::Vec2::UnitX();  // the plots' forward axis in the ground plane

@@ -24,7 +24,7 @@ Quatd local_from(const std::vector<motion::JointPose>& poses, const std::vector<
 }  // namespace
 
 AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeometry& g, const HumanMotion& human,
-                                   const std::vector<Vec3>& correction) {
+                                   const std::vector<Vec3>& correction, const std::vector<Vec2>& shift_m) {
   const std::size_t first_frame = human.first_frame;
   AppliedCorrection out;
   out.clip = clip;
@@ -37,7 +37,8 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
     out.error = "the hips joint '" + hj.name + "' has no position channels: the waist cannot turn about the hip joints";
     return out;
   }
-  if (correction.size() != clip.frame_count || human.size() != clip.frame_count) {
+  if (correction.size() != clip.frame_count || human.size() != clip.frame_count ||
+      (!shift_m.empty() && shift_m.size() != clip.frame_count)) {
     out.error = "one correction per frame is needed";
     return out;
   }
@@ -58,12 +59,13 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
       out.error = "forward kinematics failed at frame " + std::to_string(f);
       return out;
     }
-    if (f < first_frame || correction[f].norm() == 0.0) continue;
-    // The same turn and drop the filter used, in the file's frame and units.
-    const WaistTurn turn = waist_turn(human.frames[f], correction[f]);
+    const Vec2 shift = shift_m.empty() ? Vec2::Zero() : shift_m[f];
+    if (f < first_frame || (correction[f].norm() == 0.0 && shift.norm() == 0.0)) continue;
+    // The same turn, shift and drop the filter used, in the file's frame and units.
+    const WaistTurn turn = waist_turn(human.frames[f], correction[f], shift);
     const Quatd r = to_int.conjugate() * turn.rotation * to_int;
     const Vec3d pivot = to_int.conjugate() * turn.pivot / g.metres_per_unit;
-    const Vec3d drop = to_int.conjugate() * Vec3d(0, 0, -turn.drop_m) / g.metres_per_unit;
+    const Vec3d drop = to_int.conjugate() * Vec3d(turn.shift.x(), turn.shift.y(), -turn.drop_m) / g.metres_per_unit;
     global.resize(poses.size());
     for (std::size_t j = 0; j < poses.size(); ++j) global[j] = poses[j].rotation;
     // The hips and everything on the pelvis turn rigidly: new hips rotation and position.

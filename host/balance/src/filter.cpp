@@ -7,11 +7,13 @@
 
 #include "accel_operator.hpp"
 #include "tonus/host/balance/zmp.hpp"
+#include "zmp_partials.hpp"
 
 namespace tonus::balance {
 namespace {
 
 using detail::AccelOperator;
+using detail::ZmpPartials;
 
 // ZMP-equivalent scales: what one radian of correction, or one rad/s^2 of its
 // angular acceleration, moves the ZMP by, roughly, for an adult (the upper
@@ -64,28 +66,6 @@ double objective(const Analysis& a, const Targets& t, const std::vector<Vec3>& d
     }
   }
   return cost;
-}
-
-// d zmp / d (segment position) and d zmp / d (segment acceleration), 2 x 3 each,
-// from p = M / N (zmp.hpp), at one frame.
-struct ZmpPartials {
-  std::array<Eigen::Matrix<double, 2, 3>, kSegmentParts> dpos;
-  std::array<Eigen::Matrix<double, 2, 3>, kSegmentParts> dacc;
-};
-
-ZmpPartials zmp_partials(const MassModel& model, const SegmentFrame& seg, const std::array<Vec3, kSegmentParts>& acc,
-                         const Vec2& p, double ground_z, double g) {
-  ZmpPartials d;
-  double n = 0.0;
-  for (std::size_t i = 0; i < kSegmentParts; ++i) n += model.parts[i].mass_kg * (acc[i].z() + g);
-  for (std::size_t i = 0; i < kSegmentParts; ++i) {
-    const double m = model.parts[i].mass_kg / n;
-    const Vec3& c = seg[i].com;
-    const Vec3& a = acc[i];
-    d.dpos[i] << m * (a.z() + g), 0.0, -m * a.x(), 0.0, m * (a.z() + g), -m * a.y();
-    d.dacc[i] << -m * (c.z() - ground_z), 0.0, m * (c.x() - p.x()), 0.0, -m * (c.z() - ground_z), m * (c.y() - p.y());
-  }
-  return d;
 }
 
 std::size_t count_outside(const Analysis& a, double tol) {
@@ -151,8 +131,8 @@ FilterResult balance_filter(const HumanMotion& motion, const FilterOptions& o, F
       const double sw = std::sqrt(weight[k]);
       const Vec2 res = sw * (now.frames[k].zmp - targets.target[k]);
       for (int c = 0; c < 2; ++c) residual.push_back(res(c));
-      const ZmpPartials dp = zmp_partials(now.mass, now.segments[k], now.accelerations[k], now.frames[k].zmp,
-                                          contacts.ground_z_m, o.analysis.gravity);
+      const ZmpPartials dp = detail::zmp_partials(now.mass, now.segments[k], now.accelerations[k], now.frames[k].zmp,
+                                                  contacts.ground_z_m, o.analysis.gravity);
       const std::size_t kk = k - first;
       const std::size_t lo = kk > op.band ? kk - op.band : 0, hi = std::min(m - 1, kk + op.band);
       for (std::size_t jj = lo; jj <= hi; ++jj) {

@@ -41,10 +41,11 @@ Vec3 at(const MotionFrame& f, Bone b) { return f.p[sim::index(b)]; }
 
 }  // namespace
 
-WaistTurn waist_turn(const MotionFrame& in, const Vec3& delta) {
+WaistTurn waist_turn(const MotionFrame& in, const Vec3& delta, const Vec2& shift_m) {
   WaistTurn w;
   w.rotation = exp_map(delta);
   w.pivot = in.p[index(Landmark::MidHip)];
+  w.shift = Vec3(shift_m.x(), shift_m.y(), 0.0);
   // The vertical shift of the pelvis, closest to none, that keeps both hips
   // within kReach of their legs' lengths from their ankles: each leg allows an
   // interval of shifts; take the common one.
@@ -53,7 +54,7 @@ WaistTurn waist_turn(const MotionFrame& in, const Vec3& delta) {
     const Vec3 hip = at(in, leg.thigh), knee = at(in, leg.shank), ankle = at(in, leg.ankle);
     // As far as 99.9 % of the leg, or as far as the capture already has it (a kick's straight leg).
     const double reach = std::max(kReach * ((knee - hip).norm() + (ankle - knee).norm()), (ankle - hip).norm());
-    const Vec3 d = w.pivot + w.rotation * (hip - w.pivot) - ankle;
+    const Vec3 d = w.pivot + w.rotation * (hip - w.pivot) + w.shift - ankle;
     const double horizontal2 = d.x() * d.x() + d.y() * d.y();
     if (horizontal2 >= reach * reach) {  // out of reach whatever the height
       w.reachable = false;
@@ -73,12 +74,17 @@ WaistTurn waist_turn(const MotionFrame& in, const Vec3& delta) {
 }
 
 MotionFrame rotate_waist(const MotionFrame& in, const Vec3& delta, double* drop_m, bool* reachable) {
-  const WaistTurn w = waist_turn(in, delta);
+  return correct_waist(in, delta, Vec2::Zero(), drop_m, reachable);
+}
+
+MotionFrame correct_waist(const MotionFrame& in, const Vec3& delta, const Vec2& shift_m, double* drop_m,
+                          bool* reachable) {
+  const WaistTurn w = waist_turn(in, delta, shift_m);
   if (drop_m != nullptr) *drop_m = w.drop_m;
   if (reachable != nullptr) *reachable = w.reachable;
   MotionFrame out = in;
   const Vec3 down(0, 0, w.drop_m);
-  const auto move = [&](const Vec3& p) { return Vec3(w.pivot + w.rotation * (p - w.pivot) - down); };
+  const auto move = [&](const Vec3& p) { return Vec3(w.pivot + w.rotation * (p - w.pivot) + w.shift - down); };
   for (const Bone b : kUpper) {
     out.p[sim::index(b)] = move(in.p[sim::index(b)]);
     if (b != Bone::LeftUpperLeg && b != Bone::RightUpperLeg)

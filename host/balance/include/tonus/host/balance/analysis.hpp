@@ -50,6 +50,7 @@ struct Analysis {
   std::vector<FrameAnalysis> frames;
   std::vector<SegmentFrame> segments;                          // per frame
   std::vector<std::array<Vec3, kSegmentParts>> accelerations;  // per frame
+  std::vector<Vec3> angular_momentum_rate;                     // per frame (zero in the particle form)
   AnalysisSummary summary;
   std::string error;  // non-empty: the differentiation refused the series (too short, ...)
   [[nodiscard]] bool ok() const { return error.empty(); }

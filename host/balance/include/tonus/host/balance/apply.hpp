@@ -49,8 +49,11 @@ struct AppliedCorrection {
 };
 
 // `motion` is the clip's conversion (convert_motion) and `correction` the
-// filter's, one rotation vector per frame (internal frame, radians).
+// filter's, one rotation vector per frame (internal frame, radians), and
+// `shift_m` the pelvis's horizontal shift per frame (internal frame, metres;
+// empty: none).
 AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeometry& geometry,
-                                   const HumanMotion& motion, const std::vector<Vec3>& correction);
+                                   const HumanMotion& motion, const std::vector<Vec3>& correction,
+                                   const std::vector<Vec2>& shift_m = {});
 
 }  // namespace tonus::balance

@@ -39,6 +39,7 @@ struct FilterOptions {
 struct FilterResult {
   HumanMotion corrected;
   std::vector<Vec3> correction;  // per frame: the waist rotation (rotation vector, world, rad)
+  std::vector<Vec2> shift_m;     // per frame: the pelvis's horizontal shift (world, m); empty: none
   Analysis before;
   Analysis after;
   std::vector<bool> unsolved;  // per frame
@@ -65,14 +66,21 @@ FilterResult balance_filter(const HumanMotion& motion, const FilterOptions& opti
 struct WaistTurn {
   Quat rotation = Quat::Identity();
   Vec3 pivot = Vec3::Zero();
+  Vec3 shift = Vec3::Zero();  // horizontal, after the turn
+
   double drop_m = 0.0;
   bool reachable = true;
 };
-WaistTurn waist_turn(const MotionFrame& frame, const Vec3& delta);
+// `shift_m` moves the pelvis and everything above it horizontally after the
+// turn (the robust filter's pelvis translation; zero for this filter).
+WaistTurn waist_turn(const MotionFrame& frame, const Vec3& delta, const Vec2& shift_m = Vec2::Zero());
 
 // The frame with that correction applied: pelvis and upper body moved
 // rigidly, both legs re-solved by two-bone IK to keep their feet.
 MotionFrame rotate_waist(const MotionFrame& frame, const Vec3& delta, double* drop_m = nullptr,
                          bool* reachable = nullptr);
+// The same with a horizontal pelvis shift after the turn.
+MotionFrame correct_waist(const MotionFrame& frame, const Vec3& delta, const Vec2& shift_m, double* drop_m = nullptr,
+                          bool* reachable = nullptr);
 
 }  // namespace tonus::balance

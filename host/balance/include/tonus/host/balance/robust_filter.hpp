@@ -1,0 +1,79 @@
+// The robust balance filter (issue 14's second design). Where the ZMP leaves
+// the support polygon under any estimator of the family (family.hpp: 4-12 Hz,
+// particle and full form), the waist is corrected until it is a margin inside
+// under all of them:
+// - the correction is a lean (roll and pitch about the midpoint of the hip
+//   joints), a yaw and a horizontal shift of the pelvis and everything above
+//   it, the legs re-solved to keep the feet where the capture has them
+//   (filter.hpp's waist turn, plus the shift);
+// - it is a uniform cubic B-spline over time (knots `knot_spacing_s` apart), so
+//   it is smooth by construction, and a knot no violation depends on stays at
+//   exactly zero: frames far from any imbalance keep their pose;
+// - its size costs (yaw several times more than lean: it barely moves the ZMP)
+//   and is capped (lean, yaw, shift);
+// - the solve is Gauss-Newton with Levenberg-Marquardt damping on the
+//   violations of every member (a hinge: only frames within the margin of the
+//   edge or beyond cost), with the accelerations of a corrected motion taken
+//   through each member's linear acceleration operator (smoothing and
+//   differentiation are linear in the samples), so a trial step costs no new
+//   smoothing. The result is then analysed afresh under every member.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "tonus/host/balance/analysis.hpp"
+#include "tonus/host/balance/family.hpp"
+#include "tonus/host/balance/filter.hpp"
+
+namespace tonus::balance {
+
+struct RobustFilterOptions {
+  AnalysisOptions analysis;  // the family's base: its cut-off and form are varied, the rest kept
+  double margin_m = 0.015;   // kept this far inside under every member
+  double knot_spacing_s = 0.1;
+  double max_lean_rad = 0.2618;  // 15 degrees
+  double max_yaw_rad = 0.1745;   // 10 degrees
+  double max_shift_m = 0.08;
+  // Costs, as the ZMP shift (m) a unit of each is worth: a correction that
+  // moves the ZMP by x metres is paid about (weight x)^2 against x^2 of violation.
+  double lean_weight = 0.06;
+  double yaw_weight = 0.3;
+  double shift_weight = 0.06;
+  double smoothness = 1.0;  // the balance knots' second difference, relative to their size
+  // The fine layer: a pelvis shift of a few millimetres on knots 25 ms apart,
+  // which takes the capture's jitter out of the centre of mass (estimators
+  // with a high cut-off see it as centimetres of ZMP). 0 spacing: no fine layer.
+  double fine_knot_spacing_s = 0.025;
+  double max_fine_shift_m = 0.005;
+  double fine_shift_weight = 0.06;
+  int max_iterations = 40;
+};
+
+struct RobustFilterResult {
+  HumanMotion corrected;
+  std::vector<Vec3> rotation;  // per frame: the waist's turn (rotation vector, world, rad)
+  std::vector<Vec2> shift_m;   // per frame: the pelvis's horizontal shift (world, m)
+  std::vector<AnalysisOptions> members;
+  std::vector<Analysis> before;  // per member, the original
+  std::vector<Analysis> after;   // per member, the corrected motion analysed afresh
+  FamilyVerdict verdict_before;
+  FamilyVerdict verdict_after;
+  std::vector<bool> unsolved;  // per frame: outside by more than the family's threshold under some member
+  std::size_t frames_unsolved = 0;
+  std::size_t frames_unreachable = 0;  // a leg could not reach its foot (the foot would move)
+  double max_lean_rad = 0.0;
+  double max_yaw_rad = 0.0;
+  double max_shift_m = 0.0;
+  double max_drop_m = 0.0;
+  double max_foot_displacement_m = 0.0;
+  int iterations = 0;
+  std::size_t lookahead_frames = 0;  // the widest member's acceleration band plus two knots
+  std::string error;
+  [[nodiscard]] bool ok() const { return error.empty(); }
+};
+
+RobustFilterResult robust_balance_filter(const HumanMotion& motion, const RobustFilterOptions& options,
+                                         FilterProgress progress = nullptr, void* user = nullptr);
+
+}  // namespace tonus::balance

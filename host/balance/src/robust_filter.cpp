@@ -1,0 +1,514 @@
+// The robust balance filter (see robust_filter.hpp).
+#include "tonus/host/balance/robust_filter.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <cmath>
+
+#include "accel_operator.hpp"
+#include "tonus/host/balance/zmp.hpp"
+#include "zmp_partials.hpp"
+
+namespace tonus::balance {
+namespace {
+
+using detail::AccelOperator;
+
+// Per knot: the rotation vector (roll, pitch, yaw in the world) and the shift (x, y).
+constexpr std::size_t kDof = 5;
+
+// A uniform cubic B-spline over the analysed frames: frame kk (counted from
+// the first analysed frame) is a blend of knots i0 .. i0 + 3.
+struct Spline {
+  double frames_per_knot = 1.0;
+  std::size_t knots = 0;
+  void basis(std::size_t kk, std::size_t& i0, std::array<double, 4>& w) const {
+    const double u = static_cast<double>(kk) / frames_per_knot;
+    const double fl = std::floor(u);
+    const double f = u - fl;
+    i0 = static_cast<std::size_t>(fl);
+    w[0] = (1 - f) * (1 - f) * (1 - f) / 6.0;
+    w[1] = (3 * f * f * f - 6 * f * f + 4) / 6.0;
+    w[2] = (-3 * f * f * f + 3 * f * f + 3 * f + 1) / 6.0;
+    w[3] = f * f * f / 6.0;
+  }
+};
+
+// One layer of the correction: a spline over some of the five components.
+struct Layer {
+  Spline spline;
+  std::vector<std::size_t> dofs;  // which components (0-2 rotation, 3-4 shift)
+  Eigen::Index offset = 0;        // its first unknown
+  std::array<double, kDof> weight{};
+  double smoothness = 0.0;
+  std::vector<bool> pinned;  // per knot: every frame it touches is airborne
+  [[nodiscard]] Eigen::Index column(std::size_t knot, std::size_t d) const {
+    return offset + static_cast<Eigen::Index>(dofs.size() * knot + d);
+  }
+};
+
+struct Member {
+  AnalysisOptions options;
+  AccelOperator op;
+};
+
+// The motion under one set of knots: each frame's correction, pose and segments.
+struct Corrected {
+  std::vector<Vec3> rotation;
+  std::vector<Vec2> shift;
+  std::vector<MotionFrame> frames;
+  std::vector<SegmentFrame> segments;
+  std::vector<bool> changed;
+  std::vector<bool> unreachable;
+  double max_drop_m = 0.0;
+};
+
+// Where each member's ZMP is under a correction, and how far outside.
+struct Evaluation {
+  Corrected motion;
+  std::vector<std::vector<std::array<Vec3, kSegmentParts>>> acc;  // [member][frame]
+  std::vector<std::vector<Vec2>> zmp;                             // [member][frame]
+  std::vector<std::vector<double>> distance;                      // [member][frame]; -inf: not counted
+  double cost = 0.0;
+};
+
+struct Problem {
+  const HumanMotion& motion;
+  const RobustFilterOptions& o;
+  const std::vector<Member>& members;
+  const std::vector<Analysis>& base;  // per member, the original
+  std::vector<Layer> layers;
+};
+
+// A frame's correction under the knots q.
+Eigen::Matrix<double, kDof, 1> frame_value(const Problem& p, const Eigen::VectorXd& q, std::size_t kk) {
+  Eigen::Matrix<double, kDof, 1> v = Eigen::Matrix<double, kDof, 1>::Zero();
+  for (const Layer& l : p.layers) {
+    std::size_t i0 = 0;
+    std::array<double, 4> w{};
+    l.spline.basis(kk, i0, w);
+    for (std::size_t b = 0; b < 4; ++b)
+      for (std::size_t d = 0; d < l.dofs.size(); ++d)
+        v(static_cast<Eigen::Index>(l.dofs[d])) += w[b] * q(l.column(i0 + b, d));
+  }
+  return v;
+}
+
+Corrected correct(const Problem& p, const Eigen::VectorXd& q) {
+  const HumanMotion& m = p.motion;
+  const std::size_t n = m.size(), first = m.first_frame;
+  Corrected c;
+  c.rotation.assign(n, Vec3::Zero());
+  c.shift.assign(n, Vec2::Zero());
+  c.frames = m.frames;
+  c.segments = p.base.front().segments;
+  c.changed.assign(n, false);
+  c.unreachable.assign(n, false);
+  for (std::size_t t = first; t < n; ++t) {
+    const Eigen::Matrix<double, kDof, 1> v = frame_value(p, q, t - first);
+    if (v.isZero(0.0)) continue;
+    c.rotation[t] = v.head<3>();
+    c.shift[t] = v.tail<2>();
+    double drop = 0.0;
+    bool reachable = true;
+    c.frames[t] = correct_waist(m.frames[t], c.rotation[t], c.shift[t], &drop, &reachable);
+    c.segments[t] = place_segments(p.base.front().mass, c.frames[t].p);
+    c.changed[t] = true;
+    c.unreachable[t] = !reachable;
+    c.max_drop_m = std::max(c.max_drop_m, std::abs(drop));
+  }
+  return c;
+}
+
+// The direction in which the signed distance grows fastest at p (outward).
+Vec2 distance_gradient(const ConvexPolygon& poly, const Vec2& p) {
+  const std::size_t nv = poly.vertices.size();
+  if (nv >= 3) {
+    const Vec2 near = nearest_point(poly, p);
+    if ((p - near).norm() > 1e-12) return (p - near).normalized();
+    // Inside: the outward normal of the nearest edge (vertices counter-clockwise).
+    double best = 1e300;
+    Vec2 normal = Vec2::Zero();
+    for (std::size_t i = 0; i < nv; ++i) {
+      const Vec2 a = poly.vertices[i], e = poly.vertices[(i + 1) % nv] - a;
+      if (e.norm() < 1e-12) continue;
+      const Vec2 out(e.y() / e.norm(), -e.x() / e.norm());
+      const double d = -(p - a).dot(out);  // distance inside, across this edge
+      if (d < best) {
+        best = d;
+        normal = out;
+      }
+    }
+    return normal;
+  }
+  const Vec2 near = nearest_point(poly, p);
+  return (p - near).norm() > 1e-12 ? Vec2((p - near).normalized()) : Vec2::Zero();
+}
+
+// The correction's cost: each knot's size and second difference, per frame it covers.
+double regulariser(const Problem& p, const Eigen::VectorXd& q) {
+  double c = 0.0;
+  for (const Layer& l : p.layers) {
+    const std::size_t k = l.spline.knots;
+    const double fpk = l.spline.frames_per_knot;
+    for (std::size_t i = 0; i < k; ++i) {
+      for (std::size_t d = 0; d < l.dofs.size(); ++d) {
+        const double w = l.weight[l.dofs[d]], v = q(l.column(i, d));
+        c += fpk * w * w * v * v;
+        if (i == 0 || i + 1 >= k) continue;
+        const double d2 = q(l.column(i - 1, d)) - 2.0 * v + q(l.column(i + 1, d));
+        c += fpk * l.smoothness * l.smoothness * w * w * d2 * d2;
+      }
+    }
+  }
+  return c;
+}
+
+Evaluation evaluate(const Problem& p, const Eigen::VectorXd& q) {
+  Evaluation e;
+  e.motion = correct(p, q);
+  const HumanMotion& m = p.motion;
+  const std::size_t n = m.size(), first = m.first_frame;
+  const std::size_t count = p.members.size();
+  e.acc.resize(count);
+  e.zmp.resize(count);
+  e.distance.resize(count);
+  std::vector<std::size_t> changed;
+  for (std::size_t t = first; t < n; ++t)
+    if (e.motion.changed[t]) changed.push_back(t);
+  for (std::size_t mi = 0; mi < count; ++mi) {
+    const Analysis& a = p.base[mi];
+    const AccelOperator& op = p.members[mi].op;
+    auto& acc = e.acc[mi];
+    acc = a.accelerations;
+    // a(x + dx) = a(x) + D dx: only the changed frames contribute.
+    for (const std::size_t j : changed) {
+      const std::size_t jj = j - first;
+      const std::size_t lo = jj > op.band ? jj - op.band : 0, hi = std::min(op.n - 1, jj + op.band);
+      std::array<Vec3, kSegmentParts> dx;
+      for (std::size_t i = 0; i < kSegmentParts; ++i) dx[i] = e.motion.segments[j][i].com - a.segments[j][i].com;
+      for (std::size_t kk = lo; kk <= hi; ++kk) {
+        const double w = op.at(kk, jj);
+        if (w == 0.0) continue;
+        for (std::size_t i = 0; i < kSegmentParts; ++i) acc[first + kk][i] += w * dx[i];
+      }
+    }
+    e.zmp[mi].assign(n, Vec2::Zero());
+    e.distance[mi].assign(n, -1e300);
+    for (std::size_t t = first; t < n; ++t) {
+      const FrameAnalysis& f = a.frames[t];
+      if (!f.analysed || f.airborne) continue;
+      ZmpInputs in;
+      in.segments = &e.motion.segments[t];
+      in.accel = &acc[t];
+      in.angular_momentum_rate = a.angular_momentum_rate[t];  // held: the correction turns slowly
+      const ZmpResult z = zero_moment_point(a.mass, in, a.contacts.ground_z_m, p.members[mi].options.gravity);
+      if (!z.defined) continue;
+      e.zmp[mi][t] = z.zmp;
+      const double d = signed_distance(f.support, z.zmp);
+      e.distance[mi][t] = d;
+      const double h = d + p.o.margin_m;
+      if (h > 0.0) e.cost += h * h;
+    }
+  }
+  e.cost += regulariser(p, q);
+  for (std::size_t t = first; t < n; ++t)
+    e.cost += e.motion.unreachable[t] && !p.base.front().frames[t].airborne ? 1.0 : 0.0;
+  return e;
+}
+
+std::size_t worst_outside(const Evaluation& e, double threshold) {
+  std::size_t worst = 0;
+  for (const auto& d : e.distance) {
+    std::size_t k = 0;
+    for (const double v : d) k += v > threshold ? 1U : 0U;
+    worst = std::max(worst, k);
+  }
+  return worst;
+}
+
+// Caps per knot: a blend of capped knots is capped. The fine layer's shift has its own cap.
+void clamp_knots(const RobustFilterOptions& o, const std::vector<Layer>& layers, Eigen::VectorXd& q) {
+  for (const Layer& l : layers) {
+    const bool fine = l.dofs.size() == 2;
+    for (std::size_t i = 0; i < l.spline.knots; ++i) {
+      auto v = q.segment(l.column(i, 0), static_cast<Eigen::Index>(l.dofs.size()));
+      if (l.pinned[i]) {
+        v.setZero();
+        continue;
+      }
+      const Eigen::Index s0 = fine ? 0 : 3;
+      if (!fine) {
+        const double lean = v.head<2>().norm();
+        if (lean > o.max_lean_rad) v.head<2>() *= o.max_lean_rad / lean;
+        v(2) = std::clamp(v(2), -o.max_yaw_rad, o.max_yaw_rad);
+      }
+      const double cap = fine ? o.max_fine_shift_m : o.max_shift_m;
+      const double sn = v.segment<2>(s0).norm();
+      if (sn > cap) v.segment<2>(s0) *= cap / sn;
+    }
+  }
+}
+
+}  // namespace
+
+RobustFilterResult robust_balance_filter(const HumanMotion& motion, const RobustFilterOptions& o,
+                                         FilterProgress progress, void* user) {
+  RobustFilterResult r;
+  const std::size_t n = motion.size(), first = motion.first_frame;
+  const auto finite_not_negative = [](double v) { return std::isfinite(v) && v >= 0.0; };
+  if (!(std::isfinite(o.knot_spacing_s) && o.knot_spacing_s > 0.0) || !finite_not_negative(o.margin_m) ||
+      !finite_not_negative(o.max_lean_rad) || !finite_not_negative(o.max_yaw_rad) ||
+      !finite_not_negative(o.max_shift_m) || !finite_not_negative(o.lean_weight) ||
+      !finite_not_negative(o.yaw_weight) || !finite_not_negative(o.shift_weight) ||
+      !finite_not_negative(o.smoothness) || !finite_not_negative(o.fine_knot_spacing_s) ||
+      !finite_not_negative(o.max_fine_shift_m) || !finite_not_negative(o.fine_shift_weight) || o.max_iterations < 0) {
+    r.error =
+        "robust filter: the knot spacing must be positive, and the margin, limits and weights finite and not "
+        "negative";
+    return r;
+  }
+  const Analysis detected = analyse(motion, o.analysis);
+  if (!detected.ok()) {
+    r.error = detected.error;
+    return r;
+  }
+  const ContactTrack& contacts = detected.contacts;  // the feet do not move: neither do their contacts
+  r.members = estimator_family(o.analysis);
+  r.before = analyse_family(motion, r.members, contacts);
+  for (const Analysis& a : r.before) {
+    if (!a.ok()) {
+      r.error = a.error;
+      return r;
+    }
+  }
+  r.verdict_before = family_verdict(r.before, r.members);
+  const std::size_t m = n - first;
+  std::vector<Member> members;
+  for (const AnalysisOptions& mo : r.members) {
+    members.push_back({mo, detail::accel_operator(m, motion.dt_s, mo.derivatives)});
+    r.lookahead_frames = std::max(r.lookahead_frames, members.back().op.band);
+  }
+
+  Problem p{motion, o, members, r.before, {}};
+  // The balance layer (lean, yaw, shift) and the fine layer (a few millimetres
+  // of shift, fast enough to take the capture's jitter out of the centre of mass).
+  Eigen::Index unknowns = 0;
+  for (const bool fine : {false, true}) {
+    if (fine && !(o.fine_knot_spacing_s > 0.0 && o.max_fine_shift_m > 0.0)) continue;
+    Layer l;
+    l.spline.frames_per_knot = std::max(1.0, (fine ? o.fine_knot_spacing_s : o.knot_spacing_s) / motion.dt_s);
+    l.spline.knots = static_cast<std::size_t>(std::floor(static_cast<double>(m - 1) / l.spline.frames_per_knot)) + 4;
+    l.dofs = fine ? std::vector<std::size_t>{3, 4} : std::vector<std::size_t>{0, 1, 2, 3, 4};
+    l.offset = unknowns;
+    l.weight = {o.lean_weight, o.lean_weight, o.yaw_weight, fine ? o.fine_shift_weight : o.shift_weight,
+                fine ? o.fine_shift_weight : o.shift_weight};
+    l.smoothness = fine ? 0.0 : o.smoothness;
+    l.pinned.assign(l.spline.knots, true);
+    for (std::size_t kk = 0; kk < m; ++kk) {
+      if (r.before.front().frames[first + kk].airborne) continue;
+      std::size_t i0 = 0;
+      std::array<double, 4> w{};
+      l.spline.basis(kk, i0, w);
+      for (std::size_t b = 0; b < 4; ++b) l.pinned[i0 + b] = false;
+    }
+    if (!fine) r.lookahead_frames += static_cast<std::size_t>(std::ceil(2.0 * l.spline.frames_per_knot));
+    unknowns += static_cast<Eigen::Index>(l.dofs.size() * l.spline.knots);
+    p.layers.push_back(std::move(l));
+  }
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(unknowns);
+  Evaluation now = evaluate(p, q);
+  double damping = 1e-4;
+  const double h = 1e-6;
+  for (r.iterations = 0; r.iterations < o.max_iterations; ++r.iterations) {
+    if (progress != nullptr) progress(r.iterations, worst_outside(now, kFamilyThreshold_m), user);
+    // Each frame's segments under a small change of each of its correction's components.
+    std::vector<std::array<std::array<Vec3, kSegmentParts>, kDof>> dcom(n);
+    std::vector<bool> needed(n, false);
+    for (std::size_t mi = 0; mi < members.size(); ++mi) {
+      for (std::size_t t = first; t < n; ++t) {
+        if (now.distance[mi][t] + o.margin_m <= 0.0) continue;
+        const std::size_t kk = t - first, band = members[mi].op.band;
+        for (std::size_t jj = kk > band ? kk - band : 0; jj <= std::min(m - 1, kk + band); ++jj)
+          needed[first + jj] = true;
+      }
+    }
+    bool any = false;
+    for (std::size_t t = first; t < n; ++t) {
+      if (!needed[t]) continue;
+      any = true;
+      for (std::size_t e = 0; e < kDof; ++e) {
+        Vec3 rot = now.motion.rotation[t];
+        Vec2 sh = now.motion.shift[t];
+        if (e < 3)
+          rot(static_cast<Eigen::Index>(e)) += h;
+        else
+          sh(static_cast<Eigen::Index>(e - 3)) += h;
+        const SegmentFrame moved = place_segments(r.before.front().mass, correct_waist(motion.frames[t], rot, sh).p);
+        for (std::size_t i = 0; i < kSegmentParts; ++i)
+          dcom[t][e][i] = (moved[i].com - now.motion.segments[t][i].com) / h;
+      }
+    }
+    if (!any) break;  // no frame near an edge under any member: nothing to correct
+
+    // Rows: each member's violation at each frame near or past the edge.
+    using Triplet = Eigen::Triplet<double>;
+    std::vector<Triplet> jac;
+    std::vector<double> residual;
+    Eigen::VectorXd local = Eigen::VectorXd::Zero(unknowns);
+    std::vector<Eigen::Index> touched;
+    for (std::size_t mi = 0; mi < members.size(); ++mi) {
+      const Analysis& a = r.before[mi];
+      const AccelOperator& op = members[mi].op;
+      for (std::size_t t = first; t < n; ++t) {
+        const double viol = now.distance[mi][t] + o.margin_m;
+        if (viol <= 0.0) continue;
+        const Vec2 normal = distance_gradient(a.frames[t].support, now.zmp[mi][t]);
+        const detail::ZmpPartials dp =
+            detail::zmp_partials(a.mass, now.motion.segments[t], now.acc[mi][t], now.zmp[mi][t], a.contacts.ground_z_m,
+                                 members[mi].options.gravity);
+        std::array<Eigen::RowVector3d, kSegmentParts> along_pos, along_acc;
+        for (std::size_t i = 0; i < kSegmentParts; ++i) {
+          along_pos[i] = normal.transpose() * dp.dpos[i];
+          along_acc[i] = normal.transpose() * dp.dacc[i];
+        }
+        const std::size_t kk = t - first;
+        const std::size_t lo = kk > op.band ? kk - op.band : 0, hi = std::min(m - 1, kk + op.band);
+        touched.clear();
+        for (std::size_t jj = lo; jj <= hi; ++jj) {
+          const double w = op.at(kk, jj);
+          if (w == 0.0 && jj != kk) continue;
+          std::array<double, kDof> g{};
+          for (std::size_t e = 0; e < kDof; ++e) {
+            for (std::size_t i = 0; i < kSegmentParts; ++i) {
+              const Vec3& dc = dcom[first + jj][e][i];
+              g[e] += w * along_acc[i].dot(dc);
+              if (jj == kk) g[e] += along_pos[i].dot(dc);
+            }
+          }
+          for (const Layer& l : p.layers) {
+            std::size_t i0 = 0;
+            std::array<double, 4> bw{};
+            l.spline.basis(jj, i0, bw);
+            for (std::size_t b = 0; b < 4; ++b) {
+              if (l.pinned[i0 + b]) continue;
+              for (std::size_t d = 0; d < l.dofs.size(); ++d) {
+                const Eigen::Index col = l.column(i0 + b, d);
+                if (local(col) == 0.0) touched.push_back(col);
+                local(col) += g[l.dofs[d]] * bw[b];
+              }
+            }
+          }
+        }
+        const auto row = static_cast<int>(residual.size());
+        for (const Eigen::Index col : touched) {
+          if (local(col) != 0.0) jac.emplace_back(row, static_cast<int>(col), local(col));
+          local(col) = 0.0;
+        }
+        residual.push_back(viol);
+      }
+    }
+    Eigen::SparseMatrix<double> j_mat(static_cast<Eigen::Index>(residual.size()), unknowns);
+    j_mat.setFromTriplets(jac.begin(), jac.end());
+    Eigen::SparseMatrix<double> hess = j_mat.transpose() * j_mat;
+    Eigen::VectorXd grad = j_mat.transpose() * Eigen::Map<const Eigen::VectorXd>(
+                                                   residual.data(), static_cast<Eigen::Index>(residual.size()));
+    // The regulariser's exact Hessian and gradient (it is quadratic).
+    std::vector<Triplet> reg;
+    for (const Layer& l : p.layers) {
+      const double fpk = l.spline.frames_per_knot;
+      for (std::size_t i = 0; i < l.spline.knots; ++i) {
+        for (std::size_t d = 0; d < l.dofs.size(); ++d) {
+          const double w = l.weight[l.dofs[d]];
+          const auto c = static_cast<int>(l.column(i, d));
+          reg.emplace_back(c, c, fpk * w * w);
+          grad(c) += fpk * w * w * q(c);
+          if (i == 0 || i + 1 >= l.spline.knots) continue;
+          const double s2 = fpk * l.smoothness * l.smoothness * w * w;
+          if (s2 == 0.0) continue;
+          const auto stride = static_cast<int>(l.dofs.size());
+          const int idx[3] = {c - stride, c, c + stride};
+          const double coef[3] = {1.0, -2.0, 1.0};
+          double d2 = 0.0;
+          for (int a = 0; a < 3; ++a) d2 += coef[a] * q(idx[a]);
+          for (int a = 0; a < 3; ++a) {
+            grad(idx[a]) += s2 * coef[a] * d2;
+            for (int b = 0; b < 3; ++b) reg.emplace_back(idx[a], idx[b], s2 * coef[a] * coef[b]);
+          }
+        }
+      }
+    }
+    Eigen::SparseMatrix<double> reg_mat(unknowns, unknowns);
+    reg_mat.setFromTriplets(reg.begin(), reg.end());
+    hess += reg_mat;
+    for (const Layer& l : p.layers) {
+      for (std::size_t i = 0; i < l.spline.knots; ++i) {
+        if (!l.pinned[i]) continue;
+        for (std::size_t d = 0; d < l.dofs.size(); ++d) grad(l.column(i, d)) = 0.0;
+      }
+    }
+
+    bool accepted = false;
+    double improvement = 0.0;
+    for (int attempt = 0; attempt < 10 && !accepted; ++attempt) {
+      Eigen::SparseMatrix<double> damped = hess;
+      for (Eigen::Index i = 0; i < unknowns; ++i) damped.coeffRef(i, i) += damping * (1.0 + hess.coeff(i, i));
+      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(damped);
+      if (solver.info() != Eigen::Success) {
+        damping *= 10.0;
+        continue;
+      }
+      Eigen::VectorXd trial = q - solver.solve(grad);
+      clamp_knots(o, p.layers, trial);
+      Evaluation cand = evaluate(p, trial);
+      if (cand.cost < now.cost) {
+        improvement = (now.cost - cand.cost) / std::max(now.cost, 1e-300);
+        q = std::move(trial);
+        now = std::move(cand);
+        accepted = true;
+        damping = std::max(damping / 3.0, 1e-9);
+      } else {
+        damping *= 10.0;
+      }
+    }
+    if (!accepted || improvement < 1e-5) break;  // as good as it gets
+  }
+
+  // The result, analysed afresh (smoothing included) under every member.
+  r.rotation = now.motion.rotation;
+  r.shift_m = now.motion.shift;
+  r.corrected = motion;
+  r.corrected.frames = now.motion.frames;
+  r.max_drop_m = now.motion.max_drop_m;
+  r.after = analyse_family(r.corrected, r.members, contacts);
+  for (const Analysis& a : r.after) {
+    if (!a.ok()) {
+      r.error = "analysing the corrected motion: " + a.error;
+      return r;
+    }
+  }
+  r.verdict_after = family_verdict(r.after, r.members);
+  r.unsolved.assign(n, false);
+  for (std::size_t t = first; t < n; ++t) {
+    for (const Analysis& a : r.after) {
+      const FrameAnalysis& f = a.frames[t];
+      if (f.analysed && !f.airborne && f.zmp_defined && f.outside_m > kFamilyThreshold_m) r.unsolved[t] = true;
+    }
+    r.frames_unsolved += r.unsolved[t] ? 1U : 0U;
+    r.frames_unreachable += now.motion.unreachable[t] ? 1U : 0U;
+    r.max_lean_rad = std::max(r.max_lean_rad, r.rotation[t].head<2>().norm());
+    r.max_yaw_rad = std::max(r.max_yaw_rad, std::abs(r.rotation[t].z()));
+    r.max_shift_m = std::max(r.max_shift_m, r.shift_m[t].norm());
+    for (const Foot foot : {Foot::left, Foot::right}) {
+      const FootLandmarks fl = foot_landmarks(foot);
+      for (const Landmark l : {fl.ankle, fl.toe_joint, fl.toe_tip, fl.heel}) {
+        r.max_foot_displacement_m = std::max(r.max_foot_displacement_m,
+                                             (r.corrected.frames[t].p[index(l)] - motion.frames[t].p[index(l)]).norm());
+      }
+    }
+  }
+  return r;
+}
+
+}  // namespace tonus::balance

@@ -1,0 +1,165 @@
+// The robust balance filter (issue 14's second design), checked on real
+// clips by every estimator of the family, after writing and re-reading the
+// BVH, and by the independent estimator (tests/balance/independent), which
+// shares no code with the filter.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <string>
+
+#include "balance_fixtures.hpp"
+#include "independent/zmp_estimator.hpp"
+#include "tonus/host/balance/apply.hpp"
+#include "tonus/host/balance/robust_filter.hpp"
+
+namespace tonus::balance {
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+
+struct Checked {
+  FamilyVerdict written;  // the written clip, read back, its own contacts
+  std::size_t independent_before = 0;
+  std::size_t independent_after = 0;
+  std::size_t independent_supported = 0;
+};
+
+Checked run(const std::string& name, const std::string& path, double unit_m, std::size_t first_frame,
+            const RobustFilterOptions& o) {
+  const test::Loaded l = test::load(path);
+  const RobustFilterResult r = robust_balance_filter(l.conversion.motion, o);
+  REQUIRE_MESSAGE(r.ok(), r.error);
+  const AppliedCorrection applied =
+      apply_correction(l.clip, l.conversion.geometry, l.conversion.motion, r.rotation, r.shift_m);
+  REQUIRE_MESSAGE(applied.ok(), applied.error);
+  const motion::ReadResult back = motion::parse_bvh(motion::write_bvh(applied.clip, 6));
+  REQUIRE(back.ok());
+  ConvertOptions same_unit;
+  same_unit.metres_per_unit = l.conversion.geometry.metres_per_unit;
+  const Conversion again = convert_motion(back.clip, map_skeleton(back.clip), same_unit);
+  REQUIRE(again.ok());
+  Checked c;
+  c.written = family_verdict(
+      analyse_family(again.motion, r.members, detect_contacts(again.motion, o.analysis.contacts)), r.members);
+
+  // The feet that carry weight keep their captured pose; caps hold.
+  CHECK(applied.max_foot_displacement_m < 1e-3);
+  CHECK(r.max_foot_displacement_m < 1e-3);
+  CHECK(r.max_lean_rad <= o.max_lean_rad + 1e-9);
+  CHECK(r.max_yaw_rad <= o.max_yaw_rad + 1e-9);
+  CHECK(r.max_shift_m <= o.max_shift_m + o.max_fine_shift_m + 1e-9);
+  // No new Euler discontinuities in the written file.
+  const std::vector<std::size_t> jumps_before = test::rotation_jumps(l.clip),
+                                 jumps_after = test::rotation_jumps(back.clip);
+  for (std::size_t k = 0; k < jumps_before.size(); ++k) CHECK(jumps_after[k] <= jumps_before[k]);
+
+  // Local: a frame inside by 2 cm under every member, more than 0.3 s from
+  // any frame that is outside under some member, keeps its trunk's
+  // orientation within 1 degree.
+  const std::size_t n = l.conversion.motion.size();
+  std::vector<bool> needs(n, false), comfortable(n, true);
+  for (const Analysis& a : r.before) {
+    for (std::size_t t = 0; t < n; ++t) {
+      const FrameAnalysis& f = a.frames[t];
+      if (!f.analysed || f.airborne || !f.zmp_defined) {
+        comfortable[t] = false;
+        continue;
+      }
+      needs[t] = needs[t] || f.outside_m > 0.0;
+      comfortable[t] = comfortable[t] && f.outside_m <= -0.02;
+    }
+  }
+  const auto reach = static_cast<std::ptrdiff_t>(std::ceil(0.3 / l.conversion.motion.dt_s));
+  std::size_t far = 0, far_turned = 0;
+  double far_max = 0.0;
+  for (std::size_t t = 0; t < n; ++t) {
+    if (!comfortable[t]) continue;
+    bool near = false;
+    for (std::ptrdiff_t d = -reach; d <= reach && !near; ++d) {
+      const std::ptrdiff_t u = static_cast<std::ptrdiff_t>(t) + d;
+      near = u >= 0 && u < static_cast<std::ptrdiff_t>(n) && needs[static_cast<std::size_t>(u)];
+    }
+    if (near) continue;
+    ++far;
+    far_max = std::max(far_max, r.rotation[t].norm());
+    far_turned += r.rotation[t].norm() > kDegree ? 1U : 0U;
+  }
+  CHECK_MESSAGE(far_turned == 0, name << ": " << far_turned << " of " << far
+                                      << " far, comfortable frames turned by more "
+                                      << "than 1 degree (largest " << far_max / kDegree << ")");
+
+  indep::Options io;
+  io.metres_per_unit = unit_m;
+  io.first_frame = first_frame;
+  const indep::Estimate before = indep::estimate_zmp(l.clip, io), after = indep::estimate_zmp(back.clip, io);
+  REQUIRE(before.ok());
+  REQUIRE(after.ok());
+  c.independent_before = before.summary.outside;
+  c.independent_after = after.summary.outside;
+  c.independent_supported = after.summary.supported;
+
+  std::string members;
+  for (std::size_t i = 0; i < c.written.members.size(); ++i) {
+    const MemberVerdict& m = c.written.members[i];
+    members += (i == 0 ? "" : ", ") + std::to_string(static_cast<int>(m.cutoff_hz)) + (m.full ? "f " : "p ") +
+               std::to_string(r.verdict_before.members[i].outside) + "->" + std::to_string(m.outside);
+  }
+  MESSAGE(name << ": frames outside by more than 1 cm, before -> written, of " << c.written.members[0].supported << ": "
+               << members << "; independent " << c.independent_before << " -> " << c.independent_after << " of "
+               << c.independent_supported << "; lean " << r.max_lean_rad / kDegree << " deg, yaw "
+               << r.max_yaw_rad / kDegree << " deg, shift " << 100.0 * r.max_shift_m << " cm; far frames " << far
+               << ", largest turn there " << far_max / kDegree << " deg; " << r.iterations << " iterations");
+  return c;
+}
+
+TEST_CASE("robust balance filter: Bandai Namco walk, balanced under every estimator of the family") {
+  const Checked c = run("Bandai walk", test::shared_clip("dataset-1_walk_normal_001.bvh"), indep::kCentimetre_m, 0, {});
+  for (const MemberVerdict& m : c.written.members) CHECK(m.share() <= kFamilyAllowedShare);
+  CHECK(c.written.balanced());
+  // The independent estimator disagrees at heel strikes (its heel lands one
+  // or two frames later, so the ZMP, already on the landing heel, is ahead of
+  // its support): measured 37 of 195 (140 before). The goal (2 %) is not met.
+  CHECK(c.independent_after <= 45);
+  CHECK(c.independent_after * 3 < c.independent_before);
+}
+
+TEST_CASE("robust balance filter: CMU walk (bundled), most frames balanced under every estimator") {
+  RobustFilterOptions o;
+  o.max_iterations = 40;
+  const Checked c = run("CMU walk", test::bundled_clip("cmu_02_walk.bvh"), indep::kCmuUnit_m, 1, o);
+  // Measured: at most 16 of 342 under the worst member (4 Hz; 226 before
+  // under the worst, 12 Hz), 41 of 343 under the independent estimator (73
+  // before). The goal (2 %, 7 frames) is not met.
+  CHECK(c.written.members[c.written.worst].outside <= 20);
+  CHECK(c.independent_after <= 48);
+  CHECK(c.independent_after < c.independent_before);
+}
+
+TEST_CASE("robust balance filter: a clip balanced under every estimator is left exactly as it is") {
+  // The waving clip stands on both feet with its ZMP well inside throughout.
+  const test::Loaded l = test::load(test::shared_clip("dataset-2_wave-both-hands_normal_001.bvh"));
+  const RobustFilterResult r = robust_balance_filter(l.conversion.motion, {});
+  REQUIRE(r.ok());
+  CHECK(r.verdict_before.balanced());
+  double largest = 0.0;
+  for (std::size_t t = 0; t < r.rotation.size(); ++t)
+    largest = std::max({largest, r.rotation[t].norm(), r.shift_m[t].norm()});
+  CHECK(largest == 0.0);
+  CHECK(r.frames_unsolved == 0);
+}
+
+TEST_CASE("robust balance filter: absurd options are refused with a message") {
+  const test::Loaded l = test::load(test::bundled_clip("cmu_02_walk.bvh"));
+  RobustFilterOptions o;
+  o.knot_spacing_s = 0.0;
+  CHECK_FALSE(robust_balance_filter(l.conversion.motion, o).ok());
+  o = {};
+  o.margin_m = std::nan("");
+  CHECK_FALSE(robust_balance_filter(l.conversion.motion, o).ok());
+  o = {};
+  o.max_shift_m = -1.0;
+  CHECK_FALSE(robust_balance_filter(l.conversion.motion, o).ok());
+}
+
+}  // namespace
+}  // namespace tonus::balance
