@@ -30,7 +30,7 @@ Checked run(const std::string& name, const std::string& path, double unit_m, std
   const RobustFilterResult r = robust_balance_filter(l.conversion.motion, o);
   REQUIRE_MESSAGE(r.ok(), r.error);
   const AppliedCorrection applied =
-      apply_correction(l.clip, l.conversion.geometry, l.conversion.motion, r.rotation, r.shift_m);
+      apply_correction(l.clip, l.conversion.geometry, l.conversion.motion, r.rotation, r.shift_m, r.follow);
   REQUIRE_MESSAGE(applied.ok(), applied.error);
   const motion::ReadResult back = motion::parse_bvh(motion::write_bvh(applied.clip, 6));
   REQUIRE(back.ok());
@@ -133,6 +133,17 @@ TEST_CASE("robust balance filter: CMU walk (bundled), most frames balanced under
   CHECK(c.written.members[c.written.worst].outside <= 20);
   CHECK(c.independent_after <= 48);
   CHECK(c.independent_after < c.independent_before);
+}
+
+TEST_CASE("robust balance filter: Bandai Namco kicks, the kicking leg swings with the body") {
+  const Checked c =
+      run("Bandai kicks", test::shared_clip("dataset-1_kick_normal_001.bvh"), indep::kCentimetre_m, 0, {});
+  // Measured: at most 9 of 358 under the worst member (12 Hz full; 148
+  // before), 73 under the independent estimator (131 before). With the
+  // swinging foot kept where the capture has it, the worst member found 84.
+  CHECK(c.written.members[c.written.worst].outside <= 12);
+  CHECK(c.written.members[c.written.worst].share() <= 0.035);
+  CHECK(c.independent_after <= 80);
 }
 
 TEST_CASE("robust balance filter: a clip balanced under every estimator is left exactly as it is") {

@@ -101,6 +101,7 @@ balance::FilterResult as_filter_result(balance::RobustFilterResult&& r, const ba
   f.corrected = std::move(r.corrected);
   f.correction = std::move(r.rotation);
   f.shift_m = std::move(r.shift_m);
+  f.follow = std::move(r.follow);
   f.unsolved = std::move(r.unsolved);
   f.frames_unsolved = r.frames_unsolved;
   f.max_foot_displacement_m = r.max_foot_displacement_m;
@@ -200,7 +201,7 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
   if (!result.ok()) return fail(result.error);
 
   balance::AppliedCorrection applied =
-      balance::apply_correction(read.clip, conv.geometry, conv.motion, result.correction, shift_m);
+      balance::apply_correction(read.clip, conv.geometry, conv.motion, result.correction, shift_m, result.follow);
   if (!applied.ok()) return fail(applied.error);
   if (!opt.output.empty()) {
     std::ofstream out(opt.output, std::ios::binary);
@@ -269,9 +270,10 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
         shift = std::max(shift, shift_m[t].norm());
       }
       fmt::print(
-          "  correction: lean up to {:.1f} deg, yaw up to {:.1f} deg, pelvis shift up to {:.1f} cm; feet moved by at "
-          "most {:.2e} m, {} iterations\n",
-          lean * 180.0 / M_PI, yaw * 180.0 / M_PI, 100.0 * shift, applied.max_foot_displacement_m, result.iterations);
+          "  correction: lean up to {:.1f} deg, yaw up to {:.1f} deg, pelvis shift up to {:.1f} cm; feet down moved by "
+          "at most {:.2e} m, feet in the air followed the pelvis by up to {:.1f} cm; {} iterations\n",
+          lean * 180.0 / M_PI, yaw * 180.0 / M_PI, 100.0 * shift, applied.max_foot_displacement_m,
+          100.0 * applied.max_swing_foot_displacement_m, result.iterations);
     }
     // Only the joints and frames changed count, so the figure is the edit's real size.
     std::string largest;

@@ -24,7 +24,8 @@ Quatd local_from(const std::vector<motion::JointPose>& poses, const std::vector<
 }  // namespace
 
 AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeometry& g, const HumanMotion& human,
-                                   const std::vector<Vec3>& correction, const std::vector<Vec2>& shift_m) {
+                                   const std::vector<Vec3>& correction, const std::vector<Vec2>& shift_m,
+                                   const std::vector<std::array<double, 2>>& follow) {
   const std::size_t first_frame = human.first_frame;
   AppliedCorrection out;
   out.clip = clip;
@@ -38,7 +39,8 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
     return out;
   }
   if (correction.size() != clip.frame_count || human.size() != clip.frame_count ||
-      (!shift_m.empty() && shift_m.size() != clip.frame_count)) {
+      (!shift_m.empty() && shift_m.size() != clip.frame_count) ||
+      (!follow.empty() && follow.size() != clip.frame_count)) {
     out.error = "one correction per frame is needed";
     return out;
   }
@@ -62,7 +64,8 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
     const Vec2 shift = shift_m.empty() ? Vec2::Zero() : shift_m[f];
     if (f < first_frame || (correction[f].norm() == 0.0 && shift.norm() == 0.0)) continue;
     // The same turn, shift and drop the filter used, in the file's frame and units.
-    const WaistTurn turn = waist_turn(human.frames[f], correction[f], shift);
+    const WaistTurn turn =
+        waist_turn(human.frames[f], correction[f], shift, follow.empty() ? std::array<double, 2>{} : follow[f]);
     const Quatd r = to_int.conjugate() * turn.rotation * to_int;
     const Vec3d pivot = to_int.conjugate() * turn.pivot / g.metres_per_unit;
     const Vec3d drop = to_int.conjugate() * Vec3d(turn.shift.x(), turn.shift.y(), -turn.drop_m) / g.metres_per_unit;
@@ -90,24 +93,30 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
                  fu = static_cast<std::size_t>(foot);
       const Vec3d hip = poses[tu].position, knee = poses[su].position, ankle = poses[fu].position;
       const Vec3d hip2 = pivot + r * (hip - pivot) + drop;
+      // A swinging foot follows the pelvis by its share (the filter's turn, in the file's frame).
+      const double share = turn.follow[left ? 0 : 1];
+      const auto carried = [&](const Vec3d& p) { return Vec3d(p + share * (pivot + r * (p - pivot) + drop - p)); };
+      const Vec3d ankle2 = carried(ankle);
+      const Vec3d knee_pole = carried(knee);
+      const Quatd foot_turn = to_int.conjugate() * turn.foot_turn(left ? 0 : 1) * to_int;
       const double l1 = (knee - hip).norm(), l2 = (ankle - knee).norm();
-      const Vec3d d = ankle - hip2;
+      const Vec3d d = ankle2 - hip2;
       double dist = d.norm();
       if (dist < 1e-12) continue;
       const Vec3d u = d / dist;
       dist = std::min(dist, l1 + l2);
       const double a = (l1 * l1 - l2 * l2 + dist * dist) / (2.0 * dist);
       const double h = std::sqrt(std::max(l1 * l1 - a * a, 0.0));
-      Vec3d v = (knee - hip2) - (knee - hip2).dot(u) * u;
+      Vec3d v = (knee_pole - hip2) - (knee_pole - hip2).dot(u) * u;
       if (v.norm() < 1e-12) v = u.unitOrthogonal();
       v.normalize();
       const Vec3d knee2 = hip2 + a * u + h * v;
       desired[tu] = static_cast<int>(wanted.size());
       wanted.push_back(Quatd::FromTwoVectors(knee - hip, knee2 - hip2) * poses[tu].rotation);
       desired[su] = static_cast<int>(wanted.size());
-      wanted.push_back(Quatd::FromTwoVectors(ankle - knee, ankle - knee2) * poses[su].rotation);
+      wanted.push_back(Quatd::FromTwoVectors(ankle - knee, ankle2 - knee2) * poses[su].rotation);
       desired[fu] = static_cast<int>(wanted.size());
-      wanted.push_back(poses[fu].rotation);  // the foot keeps its world orientation
+      wanted.push_back(foot_turn * poses[fu].rotation);  // a planted foot keeps its world orientation
     }
     std::vector<bool> below(poses.size(), false);
     below[hu] = true;
@@ -141,18 +150,17 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
   for (std::size_t f = 0; f < clip.frame_count; ++f) {
     motion::forward_kinematics(clip, f, before);
     motion::forward_kinematics(out.clip, f, after);
-    for (const Bone b : {Bone::LeftFoot, Bone::RightFoot, Bone::LeftToes, Bone::RightToes}) {
-      const int j = bone(b);
-      if (j < 0) continue;
-      const auto ju = static_cast<std::size_t>(j);
-      out.max_foot_displacement_m =
-          std::max(out.max_foot_displacement_m, g.metres_per_unit * (after[ju].position - before[ju].position).norm());
-    }
-    for (const int tip : g.toe_tip_joint) {
-      if (tip < 0) continue;
-      const auto ju = static_cast<std::size_t>(tip);
-      out.max_foot_displacement_m =
-          std::max(out.max_foot_displacement_m, g.metres_per_unit * (after[ju].position - before[ju].position).norm());
+    // The feet that carry weight stay; a swinging foot that follows the pelvis is measured apart.
+    for (std::size_t side = 0; side < 2; ++side) {
+      const bool swinging = !follow.empty() && follow[f][side] > 0.0;
+      double& largest_here = swinging ? out.max_swing_foot_displacement_m : out.max_foot_displacement_m;
+      const int tip = g.toe_tip_joint[side];
+      for (const int j : {bone(side == 0 ? Bone::LeftFoot : Bone::RightFoot),
+                          bone(side == 0 ? Bone::LeftToes : Bone::RightToes), tip}) {
+        if (j < 0) continue;
+        const auto ju = static_cast<std::size_t>(j);
+        largest_here = std::max(largest_here, g.metres_per_unit * (after[ju].position - before[ju].position).norm());
+      }
     }
     // Every joint, mapped or not, but only where the correction changed it:
     // averaging in untouched joints would understate the edit.

@@ -43,6 +43,7 @@ struct Layer {
   std::array<double, kDof> weight{};
   double smoothness = 0.0;
   std::vector<bool> pinned;  // per knot: every frame it touches is airborne
+  std::vector<double> far;   // per knot: its cost's multiplier, growing away from any imbalance
   [[nodiscard]] Eigen::Index column(std::size_t knot, std::size_t d) const {
     return offset + static_cast<Eigen::Index>(dofs.size() * knot + d);
   }
@@ -79,7 +80,50 @@ struct Problem {
   const std::vector<Member>& members;
   const std::vector<Analysis>& base;  // per member, the original
   std::vector<Layer> layers;
+  std::vector<std::array<double, 2>> follow;  // per frame and leg: how much a swinging foot follows the pelvis
 };
+
+double smoothstep(double x) {
+  x = std::clamp(x, 0.0, 1.0);
+  return x * x * (3.0 - 2.0 * x);
+}
+
+// A foot in the air follows the pelvis, fully once it is `ramp_s` from its
+// lift-off and its touch-down and clear of the floor (a kick's foot; a
+// walk's swing foot, a few centimetres up, mostly stays), easing in and out
+// (smoothstep) so its path stays smooth; a foot down stays where the capture has it.
+std::vector<std::array<double, 2>> follow_weights(const HumanMotion& motion, const ContactTrack& contacts,
+                                                  double ramp_s) {
+  constexpr double kClearFrom_m = 0.05, kClearOver_m = 0.10;
+  const std::size_t n = contacts.frames.size(), first = motion.first_frame;
+  const double dt = motion.dt_s;
+  std::vector<std::array<double, 2>> w(n, std::array<double, 2>{});
+  if (!(ramp_s > 0.0)) return w;
+  for (std::size_t side = 0; side < 2; ++side) {
+    std::vector<double> since(n, 1e9), until(n, 1e9);  // seconds since the last / until the next contact
+    for (std::size_t t = first; t < n; ++t) {
+      if (contacts.frames[t][side].any())
+        since[t] = 0.0;
+      else if (t > first)
+        since[t] = since[t - 1] + dt;
+    }
+    for (std::size_t t = n; t-- > first;) {
+      if (contacts.frames[t][side].any())
+        until[t] = 0.0;
+      else if (t + 1 < n)
+        until[t] = until[t + 1] + dt;
+    }
+    const FootLandmarks fl = foot_landmarks(side == 0 ? Foot::left : Foot::right);
+    for (std::size_t t = first; t < n; ++t) {
+      const auto& p = motion.frames[t].p;
+      const double clearance =
+          std::min({p[index(fl.ankle)].z(), p[index(fl.toe_tip)].z(), p[index(fl.heel)].z()}) - contacts.ground_z_m;
+      w[t][side] =
+          smoothstep(std::min(since[t], until[t]) / ramp_s) * smoothstep((clearance - kClearFrom_m) / kClearOver_m);
+    }
+  }
+  return w;
+}
 
 // A frame's correction under the knots q.
 Eigen::Matrix<double, kDof, 1> frame_value(const Problem& p, const Eigen::VectorXd& q, std::size_t kk) {
@@ -112,7 +156,7 @@ Corrected correct(const Problem& p, const Eigen::VectorXd& q) {
     c.shift[t] = v.tail<2>();
     double drop = 0.0;
     bool reachable = true;
-    c.frames[t] = correct_waist(m.frames[t], c.rotation[t], c.shift[t], &drop, &reachable);
+    c.frames[t] = correct_waist(m.frames[t], c.rotation[t], c.shift[t], &drop, &reachable, p.follow[t]);
     c.segments[t] = place_segments(p.base.front().mass, c.frames[t].p);
     c.changed[t] = true;
     c.unreachable[t] = !reachable;
@@ -154,7 +198,7 @@ double regulariser(const Problem& p, const Eigen::VectorXd& q) {
     const double fpk = l.spline.frames_per_knot;
     for (std::size_t i = 0; i < k; ++i) {
       for (std::size_t d = 0; d < l.dofs.size(); ++d) {
-        const double w = l.weight[l.dofs[d]], v = q(l.column(i, d));
+        const double w = l.weight[l.dofs[d]] * l.far[i], v = q(l.column(i, d));
         c += fpk * w * w * v * v;
         if (i == 0 || i + 1 >= k) continue;
         const double d2 = q(l.column(i - 1, d)) - 2.0 * v + q(l.column(i + 1, d));
@@ -263,7 +307,9 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
       !finite_not_negative(o.max_shift_m) || !finite_not_negative(o.lean_weight) ||
       !finite_not_negative(o.yaw_weight) || !finite_not_negative(o.shift_weight) ||
       !finite_not_negative(o.smoothness) || !finite_not_negative(o.fine_knot_spacing_s) ||
-      !finite_not_negative(o.max_fine_shift_m) || !finite_not_negative(o.fine_shift_weight) || o.max_iterations < 0) {
+      !finite_not_negative(o.max_fine_shift_m) || !finite_not_negative(o.fine_shift_weight) ||
+      !finite_not_negative(o.swing_follow_ramp_s) || !(std::isfinite(o.far_weight) && o.far_weight >= 1.0) ||
+      !finite_not_negative(o.local_reach_s) || o.max_iterations < 0) {
     r.error =
         "robust filter: the knot spacing must be positive, and the margin, limits and weights finite and not "
         "negative";
@@ -291,9 +337,19 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
     r.lookahead_frames = std::max(r.lookahead_frames, members.back().op.band);
   }
 
-  Problem p{motion, o, members, r.before, {}};
+  Problem p{motion, o, members, r.before, {}, follow_weights(motion, contacts, o.swing_follow_ramp_s)};
   // The balance layer (lean, yaw, shift) and the fine layer (a few millimetres
   // of shift, fast enough to take the capture's jitter out of the centre of mass).
+  std::vector<std::size_t> imbalanced;  // frames (from the first analysed) outside under some member
+  for (std::size_t kk = 0; kk < m; ++kk) {
+    for (const Analysis& a : r.before) {
+      const FrameAnalysis& f = a.frames[first + kk];
+      if (f.analysed && !f.airborne && f.zmp_defined && f.outside_m > 0.0) {
+        imbalanced.push_back(kk);
+        break;
+      }
+    }
+  }
   Eigen::Index unknowns = 0;
   for (const bool fine : {false, true}) {
     if (fine && !(o.fine_knot_spacing_s > 0.0 && o.max_fine_shift_m > 0.0)) continue;
@@ -312,6 +368,16 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
       std::array<double, 4> w{};
       l.spline.basis(kk, i0, w);
       for (std::size_t b = 0; b < 4; ++b) l.pinned[i0 + b] = false;
+    }
+    // Locality: a knot whose peak is far (in time) from every frame that is
+    // outside under some member costs more, so a correction stays near the
+    // imbalance it answers instead of spreading along the clip.
+    l.far.assign(l.spline.knots, 1.0);
+    for (std::size_t i = 0; i < l.spline.knots; ++i) {
+      const double peak = (static_cast<double>(i) - 1.0) * l.spline.frames_per_knot;
+      double nearest = 1e9;
+      for (const std::size_t kk : imbalanced) nearest = std::min(nearest, std::abs(static_cast<double>(kk) - peak));
+      l.far[i] = 1.0 + (o.far_weight - 1.0) * smoothstep((nearest * motion.dt_s - o.local_reach_s) / o.local_reach_s);
     }
     if (!fine) r.lookahead_frames += static_cast<std::size_t>(std::ceil(2.0 * l.spline.frames_per_knot));
     unknowns += static_cast<Eigen::Index>(l.dofs.size() * l.spline.knots);
@@ -345,7 +411,8 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
           rot(static_cast<Eigen::Index>(e)) += h;
         else
           sh(static_cast<Eigen::Index>(e - 3)) += h;
-        const SegmentFrame moved = place_segments(r.before.front().mass, correct_waist(motion.frames[t], rot, sh).p);
+        const SegmentFrame moved = place_segments(
+            r.before.front().mass, correct_waist(motion.frames[t], rot, sh, nullptr, nullptr, p.follow[t]).p);
         for (std::size_t i = 0; i < kSegmentParts; ++i)
           dcom[t][e][i] = (moved[i].com - now.motion.segments[t][i].com) / h;
       }
@@ -420,7 +487,7 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
       const double fpk = l.spline.frames_per_knot;
       for (std::size_t i = 0; i < l.spline.knots; ++i) {
         for (std::size_t d = 0; d < l.dofs.size(); ++d) {
-          const double w = l.weight[l.dofs[d]];
+          const double w = l.weight[l.dofs[d]] * l.far[i];
           const auto c = static_cast<int>(l.column(i, d));
           reg.emplace_back(c, c, fpk * w * w);
           grad(c) += fpk * w * w * q(c);
@@ -476,6 +543,7 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
   }
 
   // The result, analysed afresh (smoothing included) under every member.
+  r.follow = p.follow;
   r.rotation = now.motion.rotation;
   r.shift_m = now.motion.shift;
   r.corrected = motion;
@@ -502,10 +570,10 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
     r.max_shift_m = std::max(r.max_shift_m, r.shift_m[t].norm());
     for (const Foot foot : {Foot::left, Foot::right}) {
       const FootLandmarks fl = foot_landmarks(foot);
-      for (const Landmark l : {fl.ankle, fl.toe_joint, fl.toe_tip, fl.heel}) {
-        r.max_foot_displacement_m = std::max(r.max_foot_displacement_m,
-                                             (r.corrected.frames[t].p[index(l)] - motion.frames[t].p[index(l)]).norm());
-      }
+      double& largest =
+          p.follow[t][foot == Foot::left ? 0 : 1] > 0.0 ? r.max_swing_foot_displacement_m : r.max_foot_displacement_m;
+      for (const Landmark l : {fl.ankle, fl.toe_joint, fl.toe_tip, fl.heel})
+        largest = std::max(largest, (r.corrected.frames[t].p[index(l)] - motion.frames[t].p[index(l)]).norm());
     }
   }
   return r;

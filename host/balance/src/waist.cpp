@@ -32,37 +32,53 @@ Quat exp_map(const Vec3& v) {
 }
 
 struct Leg {
-  Bone thigh, shank, ankle;
+  Bone thigh, shank, ankle, toes;
+  Landmark toe_tip, heel;
 };
-constexpr Leg kLegs[2] = {{Bone::LeftUpperLeg, Bone::LeftLowerLeg, Bone::LeftFoot},
-                          {Bone::RightUpperLeg, Bone::RightLowerLeg, Bone::RightFoot}};
+constexpr Leg kLegs[2] = {
+    {Bone::LeftUpperLeg, Bone::LeftLowerLeg, Bone::LeftFoot, Bone::LeftToes, Landmark::LeftToeTip, Landmark::LeftHeel},
+    {Bone::RightUpperLeg, Bone::RightLowerLeg, Bone::RightFoot, Bone::RightToes, Landmark::RightToeTip,
+     Landmark::RightHeel}};
 
 Vec3 at(const MotionFrame& f, Bone b) { return f.p[sim::index(b)]; }
 
 }  // namespace
 
-WaistTurn waist_turn(const MotionFrame& in, const Vec3& delta, const Vec2& shift_m) {
+Vec3 WaistTurn::ankle_target(const Vec3& ankle, std::size_t leg) const {
+  return ankle + follow[leg] * (pivot + rotation * (ankle - pivot) + shift - Vec3(0, 0, drop_m) - ankle);
+}
+
+Quat WaistTurn::foot_turn(std::size_t leg) const { return Quat::Identity().slerp(follow[leg], rotation); }
+
+WaistTurn waist_turn(const MotionFrame& in, const Vec3& delta, const Vec2& shift_m,
+                     const std::array<double, 2>& follow) {
   WaistTurn w;
   w.rotation = exp_map(delta);
   w.pivot = in.p[index(Landmark::MidHip)];
   w.shift = Vec3(shift_m.x(), shift_m.y(), 0.0);
+  w.follow = follow;
   // The vertical shift of the pelvis, closest to none, that keeps both hips
   // within kReach of their legs' lengths from their ankles: each leg allows an
   // interval of shifts; take the common one.
   double lo = -1e9, hi = 1e9;
-  for (const Leg& leg : kLegs) {
+  for (std::size_t li = 0; li < 2; ++li) {
+    const Leg& leg = kLegs[li];
     const Vec3 hip = at(in, leg.thigh), knee = at(in, leg.shank), ankle = at(in, leg.ankle);
     // As far as 99.9 % of the leg, or as far as the capture already has it (a kick's straight leg).
     const double reach = std::max(kReach * ((knee - hip).norm() + (ankle - knee).norm()), (ankle - hip).norm());
-    const Vec3 d = w.pivot + w.rotation * (hip - w.pivot) + w.shift - ankle;
+    // Before any vertical shift s (up); a partly following foot rises with the
+    // pelvis by its share, so the leg sees k s of it.
+    if (w.follow[li] >= 1.0) continue;  // the leg moves rigidly with the pelvis
+    const Vec3 d = w.pivot + w.rotation * (hip - w.pivot) + w.shift - w.ankle_target(ankle, li);
+    const double k = 1.0 - w.follow[li];
     const double horizontal2 = d.x() * d.x() + d.y() * d.y();
     if (horizontal2 >= reach * reach) {  // out of reach whatever the height
       w.reachable = false;
       continue;
     }
     const double half = std::sqrt(reach * reach - horizontal2);
-    lo = std::max(lo, -half - d.z());
-    hi = std::min(hi, half - d.z());
+    lo = std::max(lo, (-half - d.z()) / k);
+    hi = std::min(hi, (half - d.z()) / k);
   }
   if (lo > hi) {
     w.reachable = false;
@@ -78,8 +94,8 @@ MotionFrame rotate_waist(const MotionFrame& in, const Vec3& delta, double* drop_
 }
 
 MotionFrame correct_waist(const MotionFrame& in, const Vec3& delta, const Vec2& shift_m, double* drop_m,
-                          bool* reachable) {
-  const WaistTurn w = waist_turn(in, delta, shift_m);
+                          bool* reachable, const std::array<double, 2>& follow) {
+  const WaistTurn w = waist_turn(in, delta, shift_m, follow);
   if (drop_m != nullptr) *drop_m = w.drop_m;
   if (reachable != nullptr) *reachable = w.reachable;
   MotionFrame out = in;
@@ -92,17 +108,29 @@ MotionFrame correct_waist(const MotionFrame& in, const Vec3& delta, const Vec2& 
   }
   for (const Landmark l : kUpperExtras) out.p[index(l)] = move(in.p[index(l)]);
 
-  for (const Leg& leg : kLegs) {
+  for (std::size_t li = 0; li < 2; ++li) {
+    const Leg& leg = kLegs[li];
     const Vec3 hip = at(in, leg.thigh), knee = at(in, leg.shank), ankle = at(in, leg.ankle);
     const Vec3 hip2 = out.p[sim::index(leg.thigh)];
+    // A swinging foot follows the pelvis by its share; a planted one stays.
+    const Vec3 ankle2 = w.ankle_target(ankle, li);
+    const Quat foot_turn = w.foot_turn(li);
+    if (w.follow[li] > 0.0) {
+      for (const Bone b : {leg.ankle, leg.toes}) {
+        out.p[sim::index(b)] = ankle2 + foot_turn * (in.p[sim::index(b)] - ankle);
+        out.rotation[sim::index(b)] = foot_turn * in.rotation[sim::index(b)];
+      }
+      for (const Landmark l : {leg.toe_tip, leg.heel}) out.p[index(l)] = ankle2 + foot_turn * (in.p[index(l)] - ankle);
+    }
+    const Vec3 knee_pole = knee + w.follow[li] * (move(knee) - knee);
     const double l1 = (knee - hip).norm(), l2 = (ankle - knee).norm();
-    const Vec3 d = ankle - hip2;
+    const Vec3 d = ankle2 - hip2;
     const double dist = std::min(d.norm(), l1 + l2);
     if (dist < 1e-9) continue;
     const Vec3 u = d.normalized();
     const double a = (l1 * l1 - l2 * l2 + dist * dist) / (2.0 * dist);
     const double h = std::sqrt(std::max(l1 * l1 - a * a, 0.0));
-    Vec3 v = (knee - hip2) - (knee - hip2).dot(u) * u;  // towards the captured knee
+    Vec3 v = (knee_pole - hip2) - (knee_pole - hip2).dot(u) * u;  // towards the captured (or carried) knee
     if (v.norm() < 1e-9) v = u.unitOrthogonal();
     v.normalize();
     const Vec3 knee2 = hip2 + a * u + h * v;
@@ -110,7 +138,7 @@ MotionFrame correct_waist(const MotionFrame& in, const Vec3& delta, const Vec2& 
     out.rotation[sim::index(leg.thigh)] =
         Quat::FromTwoVectors(knee - hip, knee2 - hip2) * in.rotation[sim::index(leg.thigh)];
     out.rotation[sim::index(leg.shank)] =
-        Quat::FromTwoVectors(ankle - knee, ankle - knee2) * in.rotation[sim::index(leg.shank)];
+        Quat::FromTwoVectors(ankle - knee, ankle2 - knee2) * in.rotation[sim::index(leg.shank)];
   }
   return out;
 }

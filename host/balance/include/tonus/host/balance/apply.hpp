@@ -10,6 +10,7 @@
 // the written clip against the original.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -33,7 +34,8 @@ struct JointChange {
 
 struct AppliedCorrection {
   motion::Clip clip;
-  double max_foot_displacement_m = 0.0;  // ankles, toe joints and toe tips, over every frame
+  double max_foot_displacement_m = 0.0;        // ankles, toe joints and toe tips, over every frame it is planted
+  double max_swing_foot_displacement_m = 0.0;  // the same where a swinging foot followed the pelvis
   // The local-rotation change over the (joint, frame) samples that changed
   // (by more than kChangedRad), every joint and frame considered: the size of
   // the edit where it was made.
@@ -49,11 +51,13 @@ struct AppliedCorrection {
 };
 
 // `motion` is the clip's conversion (convert_motion) and `correction` the
-// filter's, one rotation vector per frame (internal frame, radians), and
+// filter's, one rotation vector per frame (internal frame, radians),
 // `shift_m` the pelvis's horizontal shift per frame (internal frame, metres;
-// empty: none).
+// empty: none) and `follow` how much each swinging foot follows the pelvis
+// per frame (WaistTurn::follow; empty: the feet stay).
 AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeometry& geometry,
                                    const HumanMotion& motion, const std::vector<Vec3>& correction,
-                                   const std::vector<Vec2>& shift_m = {});
+                                   const std::vector<Vec2>& shift_m = {},
+                                   const std::vector<std::array<double, 2>>& follow = {});
 
 }  // namespace tonus::balance

@@ -20,6 +20,7 @@
 // feet, are flagged as unsolved, never silently left.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -38,8 +39,9 @@ struct FilterOptions {
 
 struct FilterResult {
   HumanMotion corrected;
-  std::vector<Vec3> correction;  // per frame: the waist rotation (rotation vector, world, rad)
-  std::vector<Vec2> shift_m;     // per frame: the pelvis's horizontal shift (world, m); empty: none
+  std::vector<Vec3> correction;               // per frame: the waist rotation (rotation vector, world, rad)
+  std::vector<Vec2> shift_m;                  // per frame: the pelvis's horizontal shift (world, m); empty: none
+  std::vector<std::array<double, 2>> follow;  // per frame and leg: a swinging foot's share (empty: none)
   Analysis before;
   Analysis after;
   std::vector<bool> unsolved;  // per frame
@@ -67,13 +69,20 @@ struct WaistTurn {
   Quat rotation = Quat::Identity();
   Vec3 pivot = Vec3::Zero();
   Vec3 shift = Vec3::Zero();  // horizontal, after the turn
+  // Per leg (left, right): how much its foot follows the pelvis, 0 (planted:
+  // the foot stays, the leg is re-solved) to 1 (swinging: the leg moves rigidly).
+  std::array<double, 2> follow{};
+  // Where that leg's ankle goes, and its foot's turn.
+  [[nodiscard]] Vec3 ankle_target(const Vec3& ankle, std::size_t leg) const;
+  [[nodiscard]] Quat foot_turn(std::size_t leg) const;
 
   double drop_m = 0.0;
   bool reachable = true;
 };
 // `shift_m` moves the pelvis and everything above it horizontally after the
 // turn (the robust filter's pelvis translation; zero for this filter).
-WaistTurn waist_turn(const MotionFrame& frame, const Vec3& delta, const Vec2& shift_m = Vec2::Zero());
+WaistTurn waist_turn(const MotionFrame& frame, const Vec3& delta, const Vec2& shift_m = Vec2::Zero(),
+                     const std::array<double, 2>& follow = {});
 
 // The frame with that correction applied: pelvis and upper body moved
 // rigidly, both legs re-solved by two-bone IK to keep their feet.
@@ -81,6 +90,6 @@ MotionFrame rotate_waist(const MotionFrame& frame, const Vec3& delta, double* dr
                          bool* reachable = nullptr);
 // The same with a horizontal pelvis shift after the turn.
 MotionFrame correct_waist(const MotionFrame& frame, const Vec3& delta, const Vec2& shift_m, double* drop_m = nullptr,
-                          bool* reachable = nullptr);
+                          bool* reachable = nullptr, const std::array<double, 2>& follow = {});
 
 }  // namespace tonus::balance

@@ -47,13 +47,22 @@ struct RobustFilterOptions {
   double fine_knot_spacing_s = 0.025;
   double max_fine_shift_m = 0.005;
   double fine_shift_weight = 0.06;
+  // A foot in the air follows the pelvis (a kick's leg swings with the body
+  // that leans), easing in over this time after lift-off and out before
+  // touch-down; 0: every foot stays where the capture has it.
+  double swing_follow_ramp_s = 0.1;
+  // Locality: knots more than local_reach_s from every frame outside under
+  // some member cost up to far_weight times more (reached at twice that).
+  double local_reach_s = 0.1;
+  double far_weight = 10.0;
   int max_iterations = 40;
 };
 
 struct RobustFilterResult {
   HumanMotion corrected;
-  std::vector<Vec3> rotation;  // per frame: the waist's turn (rotation vector, world, rad)
-  std::vector<Vec2> shift_m;   // per frame: the pelvis's horizontal shift (world, m)
+  std::vector<Vec3> rotation;                 // per frame: the waist's turn (rotation vector, world, rad)
+  std::vector<Vec2> shift_m;                  // per frame: the pelvis's horizontal shift (world, m)
+  std::vector<std::array<double, 2>> follow;  // per frame and leg: how much the foot followed (WaistTurn::follow)
   std::vector<AnalysisOptions> members;
   std::vector<Analysis> before;  // per member, the original
   std::vector<Analysis> after;   // per member, the corrected motion analysed afresh
@@ -66,7 +75,8 @@ struct RobustFilterResult {
   double max_yaw_rad = 0.0;
   double max_shift_m = 0.0;
   double max_drop_m = 0.0;
-  double max_foot_displacement_m = 0.0;
+  double max_foot_displacement_m = 0.0;        // of the feet down (zero up to rounding)
+  double max_swing_foot_displacement_m = 0.0;  // of the feet in the air, which follow the pelvis
   int iterations = 0;
   std::size_t lookahead_frames = 0;  // the widest member's acceleration band plus two knots
   std::string error;
