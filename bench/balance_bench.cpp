@@ -8,6 +8,7 @@
 #include "tonus/host/balance/analysis.hpp"
 #include "tonus/host/balance/convert.hpp"
 #include "tonus/host/balance/filter.hpp"
+#include "tonus/host/balance/robust_filter.hpp"
 #include "tonus/host/motion/bvh.hpp"
 
 namespace {
@@ -57,6 +58,28 @@ void filter(benchmark::State& state, const std::string& path) {
   state.counters["solver_iterations"] = static_cast<double>(iterations);
 }
 
+void robust_filter(benchmark::State& state, const std::string& path) {
+  bool ok = false;
+  const balance::HumanMotion m = load(path, ok);
+  if (!ok) {
+    state.SkipWithError("clip not readable");
+    return;
+  }
+  std::size_t lookahead = 0, iterations = 0, worst = 0;
+  for (auto _ : state) {  // NOLINT(clang-analyzer-deadcode.DeadStores): Google Benchmark's loop idiom
+    const balance::RobustFilterResult f = balance::robust_balance_filter(m, balance::RobustFilterOptions{});
+    lookahead = f.lookahead_frames;
+    iterations = static_cast<std::size_t>(f.iterations);
+    worst = f.verdict_after.members.empty() ? 0 : f.verdict_after.members[f.verdict_after.worst].outside;
+    benchmark::DoNotOptimize(f.rotation.data());
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(m.size()));
+  state.counters["frames"] = static_cast<double>(m.size());
+  state.counters["lookahead_frames"] = static_cast<double>(lookahead);
+  state.counters["solver_iterations"] = static_cast<double>(iterations);
+  state.counters["worst_member_outside"] = static_cast<double>(worst);
+}
+
 const std::string kCmuWalk = std::string(TONUS_SOURCE_DIR) + "/tests/data/cmu_02_walk.bvh";
 const std::string kBandaiWalk = std::string(TONUS_SHARED_DATA_DIR) + "/bvh/dataset-1_walk_normal_001.bvh";
 
@@ -67,4 +90,6 @@ BENCHMARK_CAPTURE(analyse, bandai_walk_30hz, kBandaiWalk)->Unit(benchmark::kMill
 BENCHMARK_CAPTURE(filter, cmu_walk_120hz, kCmuWalk)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(filter, bandai_walk_30hz, kBandaiWalk)->Unit(benchmark::kMillisecond);
 
+BENCHMARK_CAPTURE(robust_filter, cmu_walk_120hz, kCmuWalk)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(robust_filter, bandai_walk_30hz, kBandaiWalk)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();
