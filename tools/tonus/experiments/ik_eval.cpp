@@ -207,8 +207,12 @@ IkRun run_condition(const std::string& condition, const IkSetup& truth, const re
   run.hand_truth_mean_mm = mean(hand_truth);
   const JointJerk solved_jerk = jerk_sums(solved);
   run.jitter_mps3 = jitter(solved_jerk, n, truth.dt_s);
+  double truth_total = 0.0;
+  for (const double j : truth.jerk) truth_total += j;
   for (std::size_t b = 0; b < sim::kBoneCount; ++b) {
     run.joint_jitter_ratio[b] = truth.jerk[b] > 0.0 ? solved_jerk[b] / truth.jerk[b] : 0.0;
+    // Which joints the excess comes from: the shares add up to jitter_ratio - 1.
+    run.joint_jitter_excess[b] = truth_total > 0.0 ? (solved_jerk[b] - truth.jerk[b]) / truth_total : 0.0;
   }
   const double source = jitter(truth.jerk, n, truth.dt_s);
   run.jitter_ratio = source > 0.0 ? run.jitter_mps3 / source : 0.0;

@@ -50,6 +50,7 @@ struct IkRun {
   double solve_mean_us = 0.0, solve_p99_us = 0.0, solve_max_us = 0.0;
   std::array<double, 21> joint_error_cm{};                // mean per joint (Bone order)
   std::array<double, 21> joint_jitter_ratio{};            // per joint, over the clip's
+  std::array<double, 21> joint_jitter_excess{};           // per joint, (solved - clip jerk) over the clip's total
   std::vector<double> frame_mpjpe_cm, frame_hand_mm;      // per frame, for the plot
   std::vector<double> ankle_x_truth_m, ankle_x_solved_m;  // left ankle along the clip's main direction
 };

@@ -57,6 +57,15 @@ nlohmann::json to_json(const IkEvalResult& r) {
                           "head_error_max_mm", "jitter_ratio"}) {
       j[k] = clean[k];
     }
+    // Per joint of the clean run: where the error and the extra jerk are.
+    nlohmann::json joints = nlohmann::json::object();
+    const IkRun& c = r.runs.front();
+    for (std::size_t b = 0; b < r.mapping.size() && b < c.joint_error_cm.size(); ++b) {
+      joints[r.mapping[b].first] = {{"error_cm", c.joint_error_cm[b]},
+                                    {"jitter_ratio", c.joint_jitter_ratio[b]},
+                                    {"jitter_excess", c.joint_jitter_excess[b]}};
+    }
+    j["joints"] = joints;
   }
   nlohmann::json runs = nlohmann::json::array();
   for (const IkRun& run : r.runs) runs.push_back(run_json(run));
