@@ -40,6 +40,7 @@ constexpr int kElbowBisections = 10;  // to 0.03 degrees
 constexpr double kReachedTolerance_m = 1e-3;
 constexpr double kPelvisKneeWeight = 0.5;
 constexpr double kTwistMargin_rad = 0.05;
+constexpr double kClavicleReachMargin_m = 0.005;  // see the clavicle
 constexpr double kElbowStayBend = 0.4;  // of the arm's reach: the wrist this much nearer, the elbow keeps fully
 
 // max(a, b) with the corner rounded over `soft`: never below either.
@@ -376,10 +377,14 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     // every time a swinging arm straightens.
     double lo = 0.0, hi = 1.0;
     Quat clav_local;
-    if ((target.pos_m - shoulder_at(0.0, clav_local)).norm() <= reach) hi = 0.0;
+    // The reach the clavicle works to is a little short of the arm's: a
+    // two-bone elbow moves as the square root of its slack near straight, so
+    // the last millimetres of reach jerk it; the clavicle takes them instead.
+    const double reach_c = reach - kClavicleReachMargin_m;
+    if ((target.pos_m - shoulder_at(0.0, clav_local)).norm() <= reach_c) hi = 0.0;
     for (int it = 0; it < kClavicleBisections && hi > 0.0; ++it) {
       const double mid = 0.5 * (lo + hi);
-      ((target.pos_m - shoulder_at(mid, clav_local)).norm() > reach ? lo : hi) = mid;
+      ((target.pos_m - shoulder_at(mid, clav_local)).norm() > reach_c ? lo : hi) = mid;
     }
     const double k = std::min(1.0, smooth_max(wanted, hi, kSoftness));
     shoulder_at(k, clav_local);
