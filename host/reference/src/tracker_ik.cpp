@@ -141,7 +141,8 @@ IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calib
   const bool times_ok = o.step_time_s > 0.0 && o.step_time_min_s > 0.0 && o.step_time_min_s <= o.step_time_s &&
                         o.hold_s >= 0.0 && o.ease_s >= 0.0 && o.recover_s >= 0.0 && o.step_lead_s >= 0.0 &&
                         o.velocity_time_constant_s >= 0.0 && o.trunk_smoothing_s >= 0.0 &&
-                        o.heading_smoothing_s >= 0.0 && o.elbow_smoothing_s >= 0.0 && o.stride_soft_fade_s >= 0.0;
+                        o.heading_smoothing_s >= 0.0 && o.elbow_smoothing_s >= 0.0 && o.stride_soft_fade_s >= 0.0 &&
+                        o.knee_smoothing_s >= 0.0 && o.tracked_knee_smoothing_s >= 0.0;
   const bool sizes_ok = o.step_threshold_m > 0.0 && o.step_turn_rad > 0.0 && o.step_lift_m >= 0.0 &&
                         o.implausible_reach_factor > 1.0 && o.leg_softness_m >= 0.0 && o.stride_softness_m >= 0.0 &&
                         o.stride_soft_speed_mps > 0.0;
@@ -533,9 +534,11 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
       const Vec3 leg = target.pos_m - hip[s];
       if (leg.norm() > 1e-6) raw_knee += leg.normalized().cross(target.rot * m.hinge_axis[bi(shank)]);
     }
-    // Smoothed as the elbows' (a foot's quick turns are the ankle's).
+    // Smoothed as the elbows' (a foot's quick turns are the ankle's), longer
+    // over a tracked foot, whose axis rolls with the ankle.
+    const bool foot_worn = m.calibration.offset[index(kFootTracker[s])].valid && ft.seen;
     smooth_pole(st.knee_pole[s], raw_knee, body_yaw * Vec3::UnitX(), !st.started,
-                detail::first_order_share(dt, o.knee_smoothing_s));
+                detail::first_order_share(dt, foot_worn ? o.tracked_knee_smoothing_s : o.knee_smoothing_s));
     Vec3 pole = st.knee_pole[s];
     IkState::Track& kt = st.track[index(kKnee[s])];
     if (m.calibration.offset[index(kKnee[s])].valid && kt.seen) {

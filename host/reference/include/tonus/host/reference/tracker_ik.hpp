@@ -71,6 +71,9 @@ struct IkOptions {
   double stride_soft_fade_s = 0.2;
   double elbow_smoothing_s = 0.05;  // time constant of the elbows' pole (0: none)
   double knee_smoothing_s = 0.05;   // ... and the knees'
+  // ... and the knees' over a tracked foot, whose left axis names the knee's
+  // plane but rolls with the ankle (a run's swing foot: 50 ms passed that on)
+  double tracked_knee_smoothing_s = 0.15;
   // Steps (3 points).
   double step_threshold_m = 0.12;  // a planted foot further than this from its place under the hip steps
   double step_turn_rad = 0.6;      // ... or turned further than this from the pelvis's heading
