@@ -141,8 +141,9 @@ IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calib
   const bool times_ok = o.step_time_s > 0.0 && o.step_time_min_s > 0.0 && o.step_time_min_s <= o.step_time_s &&
                         o.hold_s >= 0.0 && o.ease_s >= 0.0 && o.recover_s >= 0.0 && o.step_lead_s >= 0.0 &&
                         o.velocity_time_constant_s >= 0.0 && o.trunk_smoothing_s >= 0.0 &&
-                        o.heading_smoothing_s >= 0.0 && o.elbow_smoothing_s >= 0.0 && o.stride_soft_fade_s >= 0.0 &&
-                        o.knee_smoothing_s >= 0.0 && o.tracked_knee_smoothing_s >= 0.0;
+                        o.heading_smoothing_s >= 0.0 && o.waist_heading_smoothing_s >= 0.0 &&
+                        o.elbow_smoothing_s >= 0.0 && o.stride_soft_fade_s >= 0.0 && o.knee_smoothing_s >= 0.0 &&
+                        o.tracked_knee_smoothing_s >= 0.0;
   const bool sizes_ok = o.step_threshold_m > 0.0 && o.step_turn_rad > 0.0 && o.step_lift_m >= 0.0 &&
                         o.implausible_reach_factor > 1.0 && o.leg_softness_m >= 0.0 && o.stride_softness_m >= 0.0 &&
                         o.stride_soft_speed_mps > 0.0;
@@ -257,11 +258,14 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     }
   }
   double yaw = yaw_of(facing, st.body_yaw_rad);
-  // 3 points: the heading smoothed, so the hands' quick swings do not shake
-  // the trunk (the head stays exact). 6 points: the waist tracker turns it.
-  if (st.started && !m.calibration.offset[index(Tracker::waist)].valid) {
-    yaw = st.body_yaw_rad + detail::first_order_share(dt, o.heading_smoothing_s) *
-                                std::remainder(yaw - st.body_yaw_rad, 2.0 * std::numbers::pi);
+  // The heading smoothed, so the hands' quick swings do not shake the trunk
+  // (the head stays exact). 6 points: longer, as it only shapes the trunk
+  // the waist tracker carries (a kick's flailing hands turned the chest).
+  if (st.started) {
+    const bool waist_worn = m.calibration.offset[index(Tracker::waist)].valid;
+    yaw = st.body_yaw_rad +
+          detail::first_order_share(dt, waist_worn ? o.waist_heading_smoothing_s : o.heading_smoothing_s) *
+              std::remainder(yaw - st.body_yaw_rad, 2.0 * std::numbers::pi);
   }
   st.body_yaw_rad = yaw;
   const Quat heading = yaw_quat(yaw);
