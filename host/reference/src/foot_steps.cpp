@@ -61,7 +61,7 @@ bool advance_feet(const IkModel& model, IkState& state, const sim::Vec3& pelvis,
     if (f.phase < 0.0) continue;
     f.phase += dt_s / std::max(f.duration_s, 1e-3);
     if (f.phase >= 1.0) {
-      f.planted = f.to;
+      f.planted = want[s];
       f.yaw_rad = pelvis_yaw_rad;
       f.phase = -1.0;
     } else {
@@ -91,10 +91,6 @@ bool advance_feet(const IkModel& model, IkState& state, const sim::Vec3& pelvis,
       f.phase = 0.0;
       const double fast = std::clamp(speed / 1.5, 0.0, 1.0);
       f.duration_s = o.step_time_s - fast * (o.step_time_s - o.step_time_min_s);
-      // It lands where its place will be by then at the pelvis's present
-      // speed, fixed now: a foot chasing its moving place landed at the
-      // pelvis's speed and stopped dead, a jerk at every landing.
-      f.to = want[static_cast<std::size_t>(pick)] + f.duration_s * v;
       started = true;
     }
   }
@@ -105,7 +101,7 @@ bool advance_feet(const IkModel& model, IkState& state, const sim::Vec3& pelvis,
       continue;
     }
     const double k = swing_progress(f.phase);
-    sim::Vec3 p = f.from + k * (f.to - f.from);
+    sim::Vec3 p = f.from + k * (want[s] - f.from);
     // The lift keeps its quartic arc: the same push-brake bump has less jerk
     // in the limit but more at 30 Hz (measured).
     const double arc = 16.0 * f.phase * f.phase * (1.0 - f.phase) * (1.0 - f.phase);  // 1 at mid-step, flat ends

@@ -189,7 +189,6 @@ struct IkState {
     sim::Vec3 planted = sim::Vec3::Zero();  // ankle joint position
     double yaw_rad = 0.0;
     sim::Vec3 from = sim::Vec3::Zero();
-    sim::Vec3 to = sim::Vec3::Zero();  // where a step lands, fixed when it starts
     double from_yaw_rad = 0.0;
     double phase = -1.0;  // < 0: planted; [0, 1): stepping
     double duration_s = 0.0;
