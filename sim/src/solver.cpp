@@ -480,13 +480,13 @@ bool subspace_solve(Data& data, int begin, int end, size_t& m) {
 // that no rigid motion meets (four penetration depths under one face) have
 // no exact solution, and the step's least-squares answer can be far worse
 // than the sweeps' complementary one.
-bool subspace_step(Data& data, int begin, int end, std::uint64_t& updates) {
-  const double before = pass(data, begin, end, false, updates);
+// `before` is the island's residual now; on success `after` is the residual it leaves.
+bool subspace_step(Data& data, int begin, int end, double before, double& after, std::uint64_t& updates) {
   save_impulses(data, begin, end);
   size_t m = 0;
   if (!subspace_solve(data, begin, end, m)) return false;
   pass(data, begin, end, true, updates);  // projects the step back into the cones
-  const double after = pass(data, begin, end, false, updates);
+  after = pass(data, begin, end, false, updates);
   if (after < before) return true;
   restore_impulses(data, begin, end);
   return false;
@@ -523,7 +523,13 @@ void solve_rows(const Model& model, Data& data) {
       save_impulses(data, begin, end);
       const double change = pass(data, begin, end, true, updates);
       ++sweeps;
-      if (change <= opt.tolerance) {
+      // The residual is measured when a sweep changed little, and at every
+      // subspace point even when it did not: under momentum a sweep keeps
+      // taking back the push before it, so its change can sit above the
+      // tolerance for good while the residual is already within it (shower100:
+      // steps ran all 200 sweeps and ended at 6e-7).
+      const bool subspace_point = sweeps == kSubspaceFirst || sweeps % kSubspaceEvery == 0;
+      if (change <= opt.tolerance || subspace_point) {
         residual = pass(data, begin, end, false, updates);
         if (residual <= opt.tolerance) {
           done = true;
@@ -531,8 +537,14 @@ void solve_rows(const Model& model, Data& data) {
         }
       }
       if (sweeps >= opt.iterations) break;
-      if (subspace_misses < kSubspaceMisses && (sweeps == kSubspaceFirst || sweeps % kSubspaceEvery == 0)) {
-        if (subspace_step(data, begin, end, updates)) {
+      if (subspace_point && subspace_misses < kSubspaceMisses) {
+        double after = 0.0;
+        if (subspace_step(data, begin, end, residual, after, updates)) {
+          residual = after;
+          if (after <= opt.tolerance) {  // the step's own pass ended on a sweep: confirmed
+            done = true;
+            break;
+          }
           have_dir = false;  // the direction belonged to the sweeps before
           continue;
         }
