@@ -1,5 +1,6 @@
 #include "ltdl.hpp"
 
+#include <array>
 #include <bit>
 #include <cstddef>
 
@@ -12,13 +13,36 @@ inline int up(std::span<const int> parent, int k) { return parent[static_cast<st
 }  // namespace
 
 bool factor(std::span<double> h, int nv, std::span<const int> parent, int first) {
+  // A row's ancestors come in runs of consecutive dofs (a ball joint's three,
+  // a chain of hinges), so the update of an ancestor's row runs over
+  // contiguous columns instead of walking the parents. Every entry gets the
+  // same operations in the same order as the walk, so the same bits.
+  std::array<double, kMaxDofs> hk;   // row k at its ancestors, by column, before the row is scaled
+  std::array<int, kMaxDofs> lo, hi;  // the runs, nearest first
   for (int k = nv - 1; k >= first; --k) {
-    const double hkk = h[at(k, k, nv)];
+    double* row_k = &h[at(k, 0, nv)];
+    const double hkk = row_k[k];
     if (!(hkk > 0.0)) return false;
+    std::size_t runs = 0;
     for (int i = up(parent, k); i >= first; i = up(parent, i)) {
-      const double a = h[at(k, i, nv)] / hkk;
-      for (int j = i; j >= first; j = up(parent, j)) h[at(i, j, nv)] -= a * h[at(k, j, nv)];
-      h[at(k, i, nv)] = a;
+      if (runs > 0 && lo[runs - 1] == i + 1) {
+        lo[runs - 1] = i;
+      } else {
+        lo[runs] = hi[runs] = i;
+        ++runs;
+      }
+      hk[static_cast<std::size_t>(i)] = row_k[i];
+    }
+    for (std::size_t r = 0; r < runs; ++r) {
+      for (int i = hi[r]; i >= lo[r]; --i) {
+        const double a = hk[static_cast<std::size_t>(i)] / hkk;
+        double* row_i = &h[at(i, 0, nv)];
+        for (int c = lo[r]; c <= i; ++c) row_i[c] -= a * hk[static_cast<std::size_t>(c)];
+        for (std::size_t s = r + 1; s < runs; ++s) {
+          for (int c = lo[s]; c <= hi[s]; ++c) row_i[c] -= a * hk[static_cast<std::size_t>(c)];
+        }
+        row_k[i] = a;
+      }
     }
   }
   return true;
