@@ -158,14 +158,20 @@ void load_axes(const Model& model, const Data& data, int body, const std::array<
     axes.v_pre += data.cdof[k] * data.qvel[k];
     axes.v_free += data.cdof[k] * data.qvel_free[k];
   }
-  std::array<double, kMaxDofs> x;
+  // The six L^-T solves together (solve_lt_path's order, six right-hand
+  // sides side by side): each entry of L is read once for all six.
+  std::array<Vec6, kMaxDofs> x;
+  for (size_t j = begin; j < n; ++j) x[j] = data.cdof[p.dofs[j]];
+  for (size_t j = n; j-- > begin;) {
+    const Vec6 xj = x[j];
+    const double* lj = &p.l[j * kMaxDofs];
+    for (size_t i = begin; i < j; ++i) x[i] -= lj[i] * xj;
+  }
   for (size_t a = 0; a < 6; ++a) {
     const auto ai = static_cast<Eigen::Index>(a);
-    for (size_t j = begin; j < n; ++j) x[p.dofs[j]] = data.cdof[p.dofs[j]](ai);
-    ltdl::solve_lt_path(p, std::span<double>(x).first(static_cast<size_t>(nv)));
     // Prescribed dofs do not yield.
     for (size_t j = 0; j < begin; ++j) axes.w[a][j] = 0.0;
-    for (size_t j = begin; j < n; ++j) axes.w[a][j] = x[p.dofs[j]] * inv_sqrt_d[p.dofs[j]];
+    for (size_t j = begin; j < n; ++j) axes.w[a][j] = x[j](ai) * inv_sqrt_d[p.dofs[j]];
   }
 }
 
