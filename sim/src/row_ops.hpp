@@ -26,6 +26,15 @@ inline constexpr double kRowMinDiag = 1e-12;
 // without limit sweep after sweep.
 inline constexpr double kMaxRowSpeedChange = 100.0;
 
+// The number of dofs in a mask. std::popcount is a libgcc call on baseline
+// x86-64 (no POPCNT instruction); this is the same count inline.
+inline int bit_count(std::uint64_t x) {
+  x -= (x >> 1U) & 0x5555555555555555ULL;
+  x = (x & 0x3333333333333333ULL) + ((x >> 2U) & 0x3333333333333333ULL);
+  x = (x + (x >> 4U)) & 0x0F0F0F0F0F0F0F0FULL;
+  return static_cast<int>((x * 0x0101010101010101ULL) >> 56U);
+}
+
 // Limit and drive rows act on their joint's own dofs; the others are contact rows.
 inline bool is_joint_row(const Data::Row& row) {
   return row.kind == Data::Row::Kind::limit || row.kind == Data::Row::Kind::drive;
@@ -49,7 +58,7 @@ inline std::size_t drive_group_end(const Data& data, std::size_t first) {
 
 // Whether `rows` more rows on `support` fit the Jacobian pool below `limit` entries.
 inline bool jacobian_fits(const Data& data, std::uint64_t support, int rows, std::size_t limit) {
-  const auto size = static_cast<std::size_t>(std::popcount(support));
+  const auto size = static_cast<std::size_t>(bit_count(support));
   return static_cast<std::size_t>(data.jac_used) + size * static_cast<std::size_t>(rows) <= limit;
 }
 
@@ -57,7 +66,7 @@ inline bool jacobian_fits(const Data& data, std::uint64_t support, int rows, std
 // checked the pool's room). False when the rows are full.
 inline bool add_row(Data& data, Data::Row& row) {
   if (data.nrows >= static_cast<int>(kMaxRows)) return false;
-  row.jac_size = std::popcount(row.support);
+  row.jac_size = bit_count(row.support);
   row.jac_offset = row.jac_size > 0 ? data.jac_used : -1;
   data.jac_used += row.jac_size;
   data.rows[static_cast<std::size_t>(data.nrows++)] = row;

@@ -331,7 +331,7 @@ int shared_prefix(std::uint64_t a, std::uint64_t b) {
   const auto top = static_cast<unsigned>(63 - std::countl_zero(both));
   const std::uint64_t below = top == 63 ? ~std::uint64_t{0} : (std::uint64_t{2} << top) - 1;
   if ((a & below) != both || (b & below) != both) return -1;
-  return std::popcount(both);
+  return bit_count(both);
 }
 
 // Adds (sign = 1) or takes back (sign = -1) the subspace step's change.
@@ -400,7 +400,7 @@ bool subspace_factor_solve(Data& data, int begin, int end, const std::bitset<kMa
     if (released[r] || !is_active(data, r)) continue;
     const Row& ri = data.rows[r];
     const int body = grounded_body(ri);
-    const auto span = static_cast<std::uint8_t>(std::min(6, std::popcount(ri.support & free_dofs)));
+    const auto span = static_cast<std::uint8_t>(std::min(6, bit_count(ri.support & free_dofs)));
     if (body >= 0 && kept_on_body[static_cast<size_t>(body)] >= span) continue;  // depends on the kept rows
     if (m == kSubspaceRows) return false;
     const auto oi = static_cast<size_t>(std::max(ri.jac_offset, 0));
