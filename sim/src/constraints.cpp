@@ -127,16 +127,15 @@ struct BodyAxes {
 
   // Writes the row's packed y and returns |y|^2.
   double whiten(const Vec6& u, double* values, std::uint8_t* dofs) const {
+    // One pass per dof, the six axes summed in order in a register.
     const auto n = static_cast<size_t>(path.size);
-    for (size_t j = 0; j < n; ++j) values[j] = u(0) * w[0][j];
-    for (size_t a = 1; a < 6; ++a) {
-      const double ua = u(static_cast<Eigen::Index>(a));
-      for (size_t j = 0; j < n; ++j) values[j] += ua * w[a][j];
-    }
+    const double u0 = u(0), u1 = u(1), u2 = u(2), u3 = u(3), u4 = u(4), u5 = u(5);
     double norm2 = 0.0;
     for (size_t j = 0; j < n; ++j) {
+      const double y = u0 * w[0][j] + u1 * w[1][j] + u2 * w[2][j] + u3 * w[3][j] + u4 * w[4][j] + u5 * w[5][j];
+      values[j] = y;
       dofs[j] = path.dofs[j];
-      norm2 += values[j] * values[j];
+      norm2 += y * y;
     }
     return norm2;
   }
