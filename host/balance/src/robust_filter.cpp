@@ -81,6 +81,7 @@ struct Problem {
   const std::vector<Analysis>& base;  // per member, the original
   std::vector<Layer> layers;
   std::vector<std::array<double, 2>> follow;  // per frame and leg: how much a swinging foot follows the pelvis
+  Eigen::SparseMatrix<double> regulariser;    // the correction's cost, q' R q
 };
 
 double smoothstep(double x) {
@@ -190,23 +191,31 @@ Vec2 distance_gradient(const ConvexPolygon& poly, const Vec2& p) {
   return (p - near).norm() > 1e-12 ? Vec2((p - near).normalized()) : Vec2::Zero();
 }
 
-// The correction's cost: each knot's size and second difference, per frame it covers.
-double regulariser(const Problem& p, const Eigen::VectorXd& q) {
-  double c = 0.0;
-  for (const Layer& l : p.layers) {
-    const std::size_t k = l.spline.knots;
+// The correction's cost, q' R q: each knot's size and second difference, per
+// frame it covers. Quadratic, so R is built once.
+Eigen::SparseMatrix<double> regulariser_matrix(const std::vector<Layer>& layers, Eigen::Index unknowns) {
+  std::vector<Eigen::Triplet<double>> reg;
+  for (const Layer& l : layers) {
     const double fpk = l.spline.frames_per_knot;
-    for (std::size_t i = 0; i < k; ++i) {
+    for (std::size_t i = 0; i < l.spline.knots; ++i) {
       for (std::size_t d = 0; d < l.dofs.size(); ++d) {
-        const double w = l.weight[l.dofs[d]] * l.far[i], v = q(l.column(i, d));
-        c += fpk * w * w * v * v;
-        if (i == 0 || i + 1 >= k) continue;
-        const double d2 = q(l.column(i - 1, d)) - 2.0 * v + q(l.column(i + 1, d));
-        c += fpk * l.smoothness * l.smoothness * w * w * d2 * d2;
+        const double w = l.weight[l.dofs[d]] * l.far[i];
+        const auto c = static_cast<int>(l.column(i, d));
+        reg.emplace_back(c, c, fpk * w * w);
+        if (i == 0 || i + 1 >= l.spline.knots) continue;
+        const double s2 = fpk * l.smoothness * l.smoothness * w * w;
+        if (s2 == 0.0) continue;
+        const auto stride = static_cast<int>(l.dofs.size());
+        const int idx[3] = {c - stride, c, c + stride};
+        const double coef[3] = {1.0, -2.0, 1.0};
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) reg.emplace_back(idx[a], idx[b], s2 * coef[a] * coef[b]);
       }
     }
   }
-  return c;
+  Eigen::SparseMatrix<double> r(unknowns, unknowns);
+  r.setFromTriplets(reg.begin(), reg.end());
+  return r;
 }
 
 Evaluation evaluate(const Problem& p, const Eigen::VectorXd& q) {
@@ -256,7 +265,7 @@ Evaluation evaluate(const Problem& p, const Eigen::VectorXd& q) {
       if (h > 0.0) e.cost += h * h;
     }
   }
-  e.cost += regulariser(p, q);
+  e.cost += q.dot(p.regulariser * q);
   for (std::size_t t = first; t < n; ++t)
     e.cost += e.motion.unreachable[t] && !p.base.front().frames[t].airborne ? 1.0 : 0.0;
   return e;
@@ -337,7 +346,7 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
     r.lookahead_frames = std::max(r.lookahead_frames, members.back().op.band);
   }
 
-  Problem p{motion, o, members, r.before, {}, follow_weights(motion, contacts, o.swing_follow_ramp_s)};
+  Problem p{motion, o, members, r.before, {}, follow_weights(motion, contacts, o.swing_follow_ramp_s), {}};
   // The balance layer (lean, yaw, shift) and the fine layer (a few millimetres
   // of shift, fast enough to take the capture's jitter out of the centre of mass).
   std::vector<std::size_t> imbalanced;  // frames (from the first analysed) outside under some member
@@ -383,6 +392,7 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
     unknowns += static_cast<Eigen::Index>(l.dofs.size() * l.spline.knots);
     p.layers.push_back(std::move(l));
   }
+  p.regulariser = regulariser_matrix(p.layers, unknowns);
   Eigen::VectorXd q = Eigen::VectorXd::Zero(unknowns);
   Evaluation now = evaluate(p, q);
   double damping = 1e-4;
@@ -482,33 +492,8 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
     Eigen::VectorXd grad = j_mat.transpose() * Eigen::Map<const Eigen::VectorXd>(
                                                    residual.data(), static_cast<Eigen::Index>(residual.size()));
     // The regulariser's exact Hessian and gradient (it is quadratic).
-    std::vector<Triplet> reg;
-    for (const Layer& l : p.layers) {
-      const double fpk = l.spline.frames_per_knot;
-      for (std::size_t i = 0; i < l.spline.knots; ++i) {
-        for (std::size_t d = 0; d < l.dofs.size(); ++d) {
-          const double w = l.weight[l.dofs[d]] * l.far[i];
-          const auto c = static_cast<int>(l.column(i, d));
-          reg.emplace_back(c, c, fpk * w * w);
-          grad(c) += fpk * w * w * q(c);
-          if (i == 0 || i + 1 >= l.spline.knots) continue;
-          const double s2 = fpk * l.smoothness * l.smoothness * w * w;
-          if (s2 == 0.0) continue;
-          const auto stride = static_cast<int>(l.dofs.size());
-          const int idx[3] = {c - stride, c, c + stride};
-          const double coef[3] = {1.0, -2.0, 1.0};
-          double d2 = 0.0;
-          for (int a = 0; a < 3; ++a) d2 += coef[a] * q(idx[a]);
-          for (int a = 0; a < 3; ++a) {
-            grad(idx[a]) += s2 * coef[a] * d2;
-            for (int b = 0; b < 3; ++b) reg.emplace_back(idx[a], idx[b], s2 * coef[a] * coef[b]);
-          }
-        }
-      }
-    }
-    Eigen::SparseMatrix<double> reg_mat(unknowns, unknowns);
-    reg_mat.setFromTriplets(reg.begin(), reg.end());
-    hess += reg_mat;
+    hess += p.regulariser;
+    grad += p.regulariser * q;
     for (const Layer& l : p.layers) {
       for (std::size_t i = 0; i < l.spline.knots; ++i) {
         if (!l.pinned[i]) continue;
