@@ -37,7 +37,7 @@ Pose ground_pose(const Ground& g) {
   Pose p;
   p.pos = g.normal * g.offset_m;
   // Any rotation taking z onto the normal.
-  p.rot = Quat::FromTwoVectors(Vec3::UnitZ(), g.normal).toRotationMatrix();
+  p.rot = sim::quat_from_two_vectors(Vec3::UnitZ(), g.normal).toRotationMatrix();
   return p;
 }
 

@@ -128,7 +128,7 @@ Mat3 segment_inertia(double mass, double len, const Vec3& l, double rg_sag, doub
 
 Mat3 rod_inertia(double mass, double radius, double len, const Vec3& l) {
   const Mat3 local = cylinder_inertia(mass, radius, 0.5 * len);  // along z
-  const Mat3 r = Quat::FromTwoVectors(Vec3::UnitZ(), l).toRotationMatrix();
+  const Mat3 r = sim::quat_from_two_vectors(Vec3::UnitZ(), l).toRotationMatrix();
   return r * local * r.transpose();
 }
 
@@ -136,8 +136,8 @@ Pose along(const Vec3& from, const Vec3& to) {
   Pose p;
   p.pos = 0.5 * (from + to);
   const Vec3 d = to - from;
-  p.rot =
-      Quat::FromTwoVectors(Vec3::UnitZ(), d.norm() > 1e-9 ? Vec3(d.normalized()) : Vec3::UnitZ()).toRotationMatrix();
+  p.rot = sim::quat_from_two_vectors(Vec3::UnitZ(), d.norm() > 1e-9 ? Vec3(d.normalized()) : Vec3::UnitZ())
+              .toRotationMatrix();
   return p;
 }
 

@@ -98,7 +98,7 @@ SwingTwist swing_twist(const Quat& q_in, const Vec3& t_in) {
   SwingTwist st;
   st.swing = std::acos(std::clamp(t.dot(u), -1.0, 1.0));
   // What is left after undoing the swing turns about t only.
-  const Quat twist = Quat::FromTwoVectors(t, u).conjugate() * q;
+  const Quat twist = sim::quat_from_two_vectors(t, u).conjugate() * q;
   const Vec3 n = t.unitOrthogonal();
   st.twist = std::atan2(t.dot(n.cross(twist * n)), n.dot(twist * n));
   return st;

@@ -5,6 +5,8 @@
 #include <limits>
 #include <utility>
 
+#include "tonus/sim/math.hpp"
+
 namespace tonus::balance {
 namespace {
 
@@ -112,9 +114,9 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
       v.normalize();
       const Vec3d knee2 = hip2 + a * u + h * v;
       desired[tu] = static_cast<int>(wanted.size());
-      wanted.push_back(Quatd::FromTwoVectors(knee - hip, knee2 - hip2) * poses[tu].rotation);
+      wanted.push_back(sim::quat_from_two_vectors(knee - hip, knee2 - hip2) * poses[tu].rotation);
       desired[su] = static_cast<int>(wanted.size());
-      wanted.push_back(Quatd::FromTwoVectors(ankle - knee, ankle2 - knee2) * poses[su].rotation);
+      wanted.push_back(sim::quat_from_two_vectors(ankle - knee, ankle2 - knee2) * poses[su].rotation);
       desired[fu] = static_cast<int>(wanted.size());
       wanted.push_back(foot_turn * poses[fu].rotation);  // a planted foot keeps its world orientation
     }

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "tonus/host/balance/filter.hpp"
+#include "tonus/sim/math.hpp"
 
 namespace tonus::balance {
 namespace {
@@ -136,9 +137,9 @@ MotionFrame correct_waist(const MotionFrame& in, const Vec3& delta, const Vec2& 
     const Vec3 knee2 = hip2 + a * u + h * v;
     out.p[sim::index(leg.shank)] = knee2;
     out.rotation[sim::index(leg.thigh)] =
-        Quat::FromTwoVectors(knee - hip, knee2 - hip2) * in.rotation[sim::index(leg.thigh)];
+        sim::quat_from_two_vectors(knee - hip, knee2 - hip2) * in.rotation[sim::index(leg.thigh)];
     out.rotation[sim::index(leg.shank)] =
-        Quat::FromTwoVectors(ankle - knee, ankle2 - knee2) * in.rotation[sim::index(leg.shank)];
+        sim::quat_from_two_vectors(ankle - knee, ankle2 - knee2) * in.rotation[sim::index(leg.shank)];
   }
   return out;
 }

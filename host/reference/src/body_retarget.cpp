@@ -61,7 +61,7 @@ Quat least_turn(const Vec3& a, const Vec3& b, const Vec3& fallback_axis) {
     if (axis.norm() < 1e-6) axis = a1.unitOrthogonal();
     return Quat(Eigen::AngleAxisd(M_PI, axis.normalized()));
   }
-  return Quat::FromTwoVectors(a1, b1);
+  return sim::quat_from_two_vectors(a1, b1);
 }
 
 void write_quat(std::span<double> q, std::size_t a, const Quat& r) {
@@ -378,7 +378,7 @@ BodyStatus BodyRetarget::solve(const BodySample& in, BodyRetargetState& st, std:
     const Vec3 want = length_[iu] * u + length_[il] * f;
     const Vec3 now = upper * end_in_upper;
     if (now.norm() > detail::kTiny && want.norm() > detail::kTiny) {
-      upper = (Quat::FromTwoVectors(now, want) * upper).normalized();
+      upper = (sim::quat_from_two_vectors(now, want) * upper).normalized();
     }
     set_ball(iu, upper);
     set_hinge(il, hinge_towards(world[iu], il, f));

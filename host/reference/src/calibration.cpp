@@ -102,7 +102,7 @@ CalibrationResult calibrate(const TrackerFrame& standing, const CalibrationOptio
   for (int s = 0; s < 2; ++s) {
     const Bone upper = s == 0 ? Bone::LeftUpperArm : Bone::RightUpperArm;
     const Vec3 rest_dir = o[bi(upper) + 1].normalized();
-    const Quat arm = (yaw * Quat::FromTwoVectors(rest_dir, arm_dir[static_cast<std::size_t>(s)])).normalized();
+    const Quat arm = (yaw * sim::quat_from_two_vectors(rest_dir, arm_dir[static_cast<std::size_t>(s)])).normalized();
     for (std::size_t k = 0; k < 3; ++k) f.rot[bi(upper) + k] = arm;
   }
   detail::place_bones(o, root, f);

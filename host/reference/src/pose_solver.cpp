@@ -256,7 +256,7 @@ void solve_frame(const Rig& rig, const Calibration& cal, const Neutral& neutral,
           rig.body(l.lower).pos_in_parent +
           qip(l.lower) * (Quat(Eigen::AngleAxisd(angle, rig.body(l.lower).hinge_axis)) * rig.body(l.end).pos_in_parent);
       const Vec3 want = rig.length[idx(l.upper)] * *u + rig.length[idx(l.lower)] * *f;
-      target = (Quat::FromTwoVectors(target * end_in_upper, want) * target).normalized();
+      target = (sim::quat_from_two_vectors(target * end_in_upper, want) * target).normalized();
     }
     set_ball(l.upper, target);
     set_hinge(l.lower, f ? hinge_towards(world[idx(l.upper)], l.lower, *f) : 0.0);

@@ -32,7 +32,7 @@ bool frame_match(const Vec3& r, const Vec3& s, const Vec3& d, const Vec3& a, Qua
 Quat aim(const Quat& from, const Vec3& r, const Vec3& d) {
   const Vec3 now = from * r;
   if (now.norm() < kTiny || d.norm() < kTiny) return from;
-  return (Quat::FromTwoVectors(now, d) * from).normalized();
+  return (sim::quat_from_two_vectors(now, d) * from).normalized();
 }
 
 double angle_about(const Vec3& axis, const Vec3& v0, const Vec3& v) {

@@ -315,7 +315,7 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     const Vec3 guess = base + spine * m.offset[bi(Bone::Chest)] + chest * m.offset[bi(Bone::Neck)];
     Vec3 neck_joint;
     const bool reachable = reach_head(base, guess, m.offset[bi(Bone::Head)].norm(), head.pos_m, neck_joint);
-    const Quat turn = Quat::FromTwoVectors(guess - base, neck_joint - base);
+    const Quat turn = sim::quat_from_two_vectors(guess - base, neck_joint - base);
     settle_ball(m, w, Bone::Spine, (turn * spine).normalized());
     settle_ball(m, w, Bone::Chest, (turn * chest).normalized());
     const Quat neck = (carry * w.f.rot[bi(Bone::Neck)]).normalized();
@@ -349,7 +349,7 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     // Neutral: hanging at the side, the hand in line with the forearm.
     const Vec3 rest_arm = m.rest_dir[bi(upper)];
     const Vec3 down = (body_yaw * Vec3(0.0, 0.15 * rest_arm.y(), -1.0)).normalized();
-    const Quat hang = (body_yaw * Quat::FromTwoVectors(rest_arm, body_yaw.conjugate() * down)).normalized();
+    const Quat hang = (body_yaw * sim::quat_from_two_vectors(rest_arm, body_yaw.conjugate() * down)).normalized();
     const Vec3 shoulder_rest = clav_pos + chest * m.offset[bi(upper)];
     const TrackerPose neutral{shoulder_rest + reach * down, hang, true};
     TrackerPose target = neutral;
@@ -367,7 +367,8 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     // across its twist axis, its own direction), so a share of it is that
     // share of the angle, and the swing cone caps the share: no clamp inside
     // the bisection below.
-    const Eigen::AngleAxisd full(to_hand.norm() > 1e-9 ? Quat::FromTwoVectors(clav_dir, to_hand) : Quat::Identity());
+    const Eigen::AngleAxisd full(to_hand.norm() > 1e-9 ? sim::quat_from_two_vectors(clav_dir, to_hand)
+                                                       : Quat::Identity());
     const double cap = full.angle() > m.limit[bi(clav)].swing_max_rad && m.limit[bi(clav)].enabled
                            ? m.limit[bi(clav)].swing_max_rad / full.angle()
                            : 1.0;

@@ -56,7 +56,7 @@ TwoBoneSolution solve_two_bone(const TwoBoneLimb& limb, const sim::Vec3& root, c
   const sim::Vec3 f = (end - middle.pos) / b;
   const sim::Vec3 n = middle.side.cross(dir);  // the hinge axis in the world for a positive bend
   if (!frame_match(limb.upper_dir, limb.hinge, u, n, s.upper)) {
-    s.upper = sim::Quat::FromTwoVectors(limb.upper_dir, u);
+    s.upper = sim::quat_from_two_vectors(limb.upper_dir, u);
   }
   s.hinge_rad = angle_about(limb.hinge, limb.lower_dir, s.upper.conjugate() * f);
   return s;

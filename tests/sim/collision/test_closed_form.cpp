@@ -411,7 +411,7 @@ TEST_CASE("collision: box-box") {
     for (const ContactPoint& p : pts) CHECK(p.dist_m == doctest::Approx(0.005));
   }
   SUBCASE("corner down onto the palm: one point") {
-    const Mat3 r = Quat::FromTwoVectors(Vec3(1, 1, 1), Vec3(0, 0, -1)).toRotationMatrix();
+    const Mat3 r = quat_from_two_vectors(Vec3(1, 1, 1), Vec3(0, 0, -1)).toRotationMatrix();
     const auto pts = contacts(cube, at(0, 0, 0.01 + 0.03 * std::sqrt(3.0) + 0.002, r), palm, at(0, 0, 0), 0.005);
     REQUIRE(pts.size() == 1);
     check_point(pts[0], {0, 0, 0.011}, {0, 0, 1}, 0.002);

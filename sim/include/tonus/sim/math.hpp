@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 
 namespace tonus::sim {
@@ -62,6 +63,36 @@ inline Vec3 quat_between(const Quat& a, const Quat& b) { return quat_log((a.conj
 // velocity is expressed in the rotating (local) frame.
 inline Quat quat_integrate(const Quat& q, const Vec3& omega_local, double dt_s) {
   return (q * quat_exp(omega_local * dt_s)).normalized();
+}
+
+// The shortest-arc rotation taking the direction of `from` to that of `to`
+// (neither need be unit). The same arithmetic as Eigen's
+// Quaternion::FromTwoVectors, bit for bit, except for opposite directions,
+// where it turns by pi about an axis across `from` found in closed form:
+// Eigen's version finds that axis with a JacobiSVD, whose instantiation alone
+// costs every translation unit that calls it seconds of compile time.
+inline Quat quat_from_two_vectors(const Vec3& from, const Vec3& to) {
+  const Vec3 v0 = from.normalized();
+  const Vec3 v1 = to.normalized();
+  double c = v1.dot(v0);
+  Quat q;
+  if (c < -1.0 + 1e-12) {  // opposite: any axis across both turns one onto the other
+    c = std::max(c, -1.0);
+    const Vec3 mid = v0 - v1;  // along v0 (v1 is nearly -v0): any axis across it will do
+    const Vec3 other = std::abs(mid.x()) < std::abs(mid.y())
+                           ? (std::abs(mid.x()) < std::abs(mid.z()) ? Vec3::UnitX() : Vec3::UnitZ())
+                           : (std::abs(mid.y()) < std::abs(mid.z()) ? Vec3::UnitY() : Vec3::UnitZ());
+    const Vec3 axis = mid.cross(other).normalized();
+    const double w2 = (1.0 + c) * 0.5;
+    q.w() = std::sqrt(w2);
+    q.vec() = axis * std::sqrt(1.0 - w2);
+    return q;
+  }
+  const Vec3 axis = v0.cross(v1);
+  const double s = std::sqrt((1.0 + c) * 2.0);
+  q.vec() = axis * (1.0 / s);
+  q.w() = s * 0.5;
+  return q;
 }
 
 inline bool all_finite(const Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
