@@ -8,6 +8,7 @@
 #include <string>
 
 #include "balance_fixtures.hpp"
+#include "support/sanitized.hpp"
 #include "tonus/host/balance/apply.hpp"
 #include "tonus/host/balance/filter.hpp"
 
@@ -80,7 +81,9 @@ void check_clip(const std::string& name, const std::string& path) {
 }  // namespace
 
 TEST_CASE("balance: CMU walk (bundled)") { check_clip("cmu_02_walk", test::bundled_clip("cmu_02_walk.bvh")); }
-TEST_CASE("balance: CMU forward jumps") { check_clip("cmu_01_01_jumps", test::shared_clip("cmu_01_01_jumps.bvh")); }
+TEST_CASE("balance: CMU forward jumps" * tonus::test::heavy_under_sanitizers()) {
+  check_clip("cmu_01_01_jumps", test::shared_clip("cmu_01_01_jumps.bvh"));
+}
 TEST_CASE("balance: Bandai Namco walk") {
   check_clip("dataset-1_walk", test::shared_clip("dataset-1_walk_normal_001.bvh"));
 }
@@ -90,7 +93,7 @@ TEST_CASE("balance: Bandai Namco run") {
 TEST_CASE("balance: Bandai Namco kicks on one leg") {
   check_clip("dataset-1_kick", test::shared_clip("dataset-1_kick_normal_001.bvh"));
 }
-TEST_CASE("balance: Bandai Namco punches") {
+TEST_CASE("balance: Bandai Namco punches" * tonus::test::heavy_under_sanitizers()) {
   check_clip("dataset-1_punch", test::shared_clip("dataset-1_punch_normal_001.bvh"));
 }
 TEST_CASE("balance: Bandai Namco waving, standing") {

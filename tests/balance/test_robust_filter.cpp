@@ -9,6 +9,7 @@
 
 #include "balance_fixtures.hpp"
 #include "independent/zmp_estimator.hpp"
+#include "support/sanitized.hpp"
 #include "tonus/host/balance/apply.hpp"
 #include "tonus/host/balance/robust_filter.hpp"
 
@@ -123,7 +124,8 @@ TEST_CASE("robust balance filter: Bandai Namco walk, balanced under every estima
   CHECK(c.independent_after * 3 < c.independent_before);
 }
 
-TEST_CASE("robust balance filter: CMU walk (bundled), most frames balanced under every estimator") {
+TEST_CASE("robust balance filter: CMU walk (bundled), most frames balanced under every estimator" *
+          tonus::test::heavy_under_sanitizers()) {
   RobustFilterOptions o;
   o.max_iterations = 40;
   const Checked c = run("CMU walk", test::bundled_clip("cmu_02_walk.bvh"), indep::kCmuUnit_m, 1, o);
@@ -135,7 +137,8 @@ TEST_CASE("robust balance filter: CMU walk (bundled), most frames balanced under
   CHECK(c.independent_after < c.independent_before);
 }
 
-TEST_CASE("robust balance filter: Bandai Namco kicks, the kicking leg swings with the body") {
+TEST_CASE("robust balance filter: Bandai Namco kicks, the kicking leg swings with the body" *
+          tonus::test::heavy_under_sanitizers()) {
   const Checked c =
       run("Bandai kicks", test::shared_clip("dataset-1_kick_normal_001.bvh"), indep::kCentimetre_m, 0, {});
   // Measured: at most 9 of 358 under the worst member (12 Hz full; 148

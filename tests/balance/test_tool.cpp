@@ -9,6 +9,7 @@
 #include <fstream>
 #include <string>
 #include "support/read_file.hpp"
+#include "support/sanitized.hpp"
 
 using tonus::test::read_file;
 
@@ -67,7 +68,8 @@ TEST_CASE("tonus zmp: corrects the bundled walk and writes BVH, CSV, JSON and SV
   CHECK(read_file(temp("again.json")).find("\"frames_outside_before\": 0,") != std::string::npos);
 }
 
-TEST_CASE("tonus zmp: every report gives the verdict of each estimator of the family") {
+TEST_CASE("tonus zmp: every report gives the verdict of each estimator of the family" *
+          tonus::test::heavy_under_sanitizers()) {
   const std::string clip = std::string(TONUS_SOURCE_DIR) + "/tests/data/cmu_02_walk.bvh";
   const Run r = run(clip + " --json " + temp("family.json"));
   INFO(r.out);

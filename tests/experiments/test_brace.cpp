@@ -5,10 +5,12 @@
 #include "experiments/brace.hpp"
 #include "experiments/reports.hpp"
 #include "experiments/scene.hpp"
+#include "support/sanitized.hpp"
 
 using namespace tonus::experiments;
 
-TEST_CASE("brace: a stiffer performer is pushed less, at the chest and at the head") {
+TEST_CASE("brace: a stiffer performer is pushed less, at the chest and at the head" *
+          tonus::test::heavy_under_sanitizers()) {
   std::string err;
   const auto m = humanoid_model(err);
   REQUIRE(m);

@@ -7,16 +7,18 @@
 #include "experiments/reports.hpp"
 #include "experiments/scene.hpp"
 #include "experiments/track.hpp"
+#include "support/sanitized.hpp"
 
 using namespace tonus::experiments;
 using tonus::avatar::Feedforward;
 
-TEST_CASE("track: the bundled CMU walk and a Bandai Namco walk, three variants") {
+TEST_CASE("track: the bundled CMU walk and a Bandai Namco walk, three variants" *
+          tonus::test::heavy_under_sanitizers()) {
   std::string err;
   const auto m = humanoid_model(err);
   REQUIRE(m);
   TrackOptions opt;
-  opt.clips.push_back(std::string(TONUS_SOURCE_DIR) + "/tests/data/cmu_02_walk.bvh");
+  opt.clips.emplace_back(TONUS_SOURCE_DIR "/tests/data/cmu_02_walk.bvh");
   const std::string bandai = std::string(TONUS_SHARED_DATA_DIR) + "/bvh/dataset-1_walk_normal_001.bvh";
   if (std::filesystem::exists(bandai)) opt.clips.push_back(bandai);
   opt.max_seconds = 2.5;

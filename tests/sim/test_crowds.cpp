@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "sim_fixtures.hpp"
+#include "support/sanitized.hpp"
 #include "tonus/sim/objects.hpp"
 #include "tonus/sim/step.hpp"
 
@@ -95,7 +96,8 @@ DropResult drop_and_settle(const Model& model, int steps) {
 
 }  // namespace
 
-TEST_CASE("a hundred cubes dropped on and around the avatar all come to rest, the floor and the avatar carry them") {
+TEST_CASE("a hundred cubes dropped on and around the avatar all come to rest, the floor and the avatar carry them" *
+          tonus::test::heavy_under_sanitizers()) {
   const auto model = test::humanoid(Features{});
   const DropResult r = drop_and_settle(*model, 4000);
   MESSAGE("100 cubes after 4 s: " << r.below_floor << " below the floor, " << r.moving << " moving, " << r.unsupported

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "sim_fixtures.hpp"
+#include "support/sanitized.hpp"
 #include "tonus/sim/mjcf.hpp"
 
 using namespace tonus::sim;
@@ -101,7 +102,8 @@ TEST_CASE("with gravity, from a random pose, Euler trajectories match MuJoCo's")
   CHECK(c.over_500ms < 1e-6);
 }
 
-TEST_CASE("energy and momentum over 10 s at dt = 1 ms, zero gravity, random velocities") {
+TEST_CASE("energy and momentum over 10 s at dt = 1 ms, zero gravity, random velocities" *
+          tonus::test::heavy_under_sanitizers()) {
   // RK4 (the validation integrator) under violent motion: N(0, 1) rad/s on every dof.
   // Euler (the real-time one) is first order: its drift is reported at N(0, 0.3);
   // without any damping its velocity-product terms pump energy into light links.

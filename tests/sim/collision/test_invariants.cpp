@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "reference.hpp"
+#include "support/sanitized.hpp"
 #include "tonus/sim/collision.hpp"
 
 using namespace tonus::sim;
@@ -20,7 +21,7 @@ using namespace tonus::sim::test;
 
 namespace {
 
-constexpr int kCasesPerPair = 2500;
+constexpr int kCasesPerPair = tonus::test::sanitized_cases(2500);
 
 // Tolerances, each a bound the measured errors stay well under (the figures
 // are printed by the test and recorded in sim/collision/README.md).

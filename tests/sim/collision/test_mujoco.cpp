@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "reference.hpp"
+#include "support/sanitized.hpp"
 #include "tonus/sim/collision.hpp"
 
 using namespace tonus::sim;
@@ -227,7 +228,7 @@ TEST_CASE("collision: MuJoCo 2.2.2: minimum signed distance and deepest normal o
       {ShapeType::box, ShapeType::box},
       {ShapeType::plane, ShapeType::box},
   }};
-  constexpr int kCases = 3000;
+  constexpr int kCases = tonus::test::sanitized_cases(3000);
   std::uint64_t seed = 77001;
   for (const auto& [t1, t2] : pairs) {
     const std::string pair_name = std::string(name(t1)) + "-" + name(t2);
