@@ -73,6 +73,11 @@ int run(int argc, char** argv) {
                    "Correction: rotation (the waist rotation, under one estimator) or waist (lean, yaw and pelvis "
                    "shift, robust under the estimator family)")
       ->check(CLI::IsMember({"rotation", "waist"}));
+  zmp_cmd->add_flag("--online", zmp.online,
+                    "Correct as a stream: each frame from the ones before it and --lookahead ahead (pelvis shift by "
+                    "ZMP preview control)");
+  zmp_cmd->add_option("--lookahead", zmp.lookahead_s, "--online: how far ahead the filter sees, s")
+      ->check(CLI::Range(0.001, 0.25));
   zmp_cmd->add_option("--margin", zmp.margin_m, "Aim this far inside the support polygon, m")
       ->check(CLI::Range(0.0, 0.05));
   zmp_cmd->add_option("--max-correction", zmp.max_correction_rad, "Largest waist rotation per frame, rad")

@@ -3,6 +3,8 @@
 #include <fmt/core.h>
 #include <unistd.h>
 
+#include <array>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -12,6 +14,7 @@
 #include "tonus/host/balance/convert.hpp"
 #include "tonus/host/balance/family.hpp"
 #include "tonus/host/balance/filter.hpp"
+#include "tonus/host/balance/online_filter.hpp"
 #include "tonus/host/balance/robust_filter.hpp"
 #include "tonus/host/motion/bvh.hpp"
 #include "tonus/sim/human_bones.hpp"
@@ -111,6 +114,50 @@ balance::FilterResult as_filter_result(balance::RobustFilterResult&& r, const ba
   return f;
 }
 
+// The streaming filter run over the clip frame by frame, in the report's
+// shape; its cost per frame goes to `cost_us` (mean, max).
+bool online_result(const balance::HumanMotion& motion, const balance::AnalysisOptions& base,
+                   const ZmpCommandOptions& opt, balance::FilterResult& f, std::array<double, 2>& cost_us,
+                   std::string& error) {
+  balance::OnlineOptions oo;
+  oo.analysis = base;
+  oo.dt_s = motion.dt_s;
+  oo.lookahead_s = opt.lookahead_s;
+  oo.margin_m = opt.margin_m > 0.0 ? opt.margin_m : 0.01;
+  auto created = balance::OnlineBalance::create(oo);
+  if (!created) {
+    error = created.error;
+    return false;
+  }
+  balance::OnlineBalance& filter = *created.filter;
+  f.corrected = motion;
+  f.correction.assign(motion.size(), balance::Vec3::Zero());
+  f.shift_m.assign(motion.size(), balance::Vec2::Zero());
+  f.unsolved.assign(motion.size(), false);
+  balance::OnlineFrame out;
+  const auto take = [&] {
+    f.corrected.frames[out.index] = out.corrected;
+    f.shift_m[out.index] = out.shift_m;
+    f.max_drop_m = std::max(f.max_drop_m, out.drop_m);
+  };
+  double total_us = 0.0;
+  cost_us = {0.0, 0.0};
+  for (const balance::MotionFrame& frame : motion.frames) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const bool got = filter.push(frame, out);
+    const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
+    total_us += us;
+    cost_us[1] = std::max(cost_us[1], us);
+    if (got) take();
+  }
+  while (filter.flush(out)) take();
+  cost_us[0] = motion.size() > 0 ? total_us / static_cast<double>(motion.size()) : 0.0;
+  f.before = balance::analyse(motion, base);
+  f.after = balance::analyse(f.corrected, base, &f.before.contacts);
+  f.operator_band = filter.lookahead_frames();
+  return true;
+}
+
 }  // namespace
 
 int run_zmp_command(const ZmpCommandOptions& opt) {
@@ -184,7 +231,11 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
   Progress progress{!opt.quiet && (isatty(STDERR_FILENO) != 0 || conv.motion.size() > 1000)};
   balance::FilterResult result;
   std::vector<balance::Vec2> shift_m;
-  if (opt.correction == "waist") {
+  std::array<double, 2> online_cost_us{};
+  if (opt.online) {
+    if (!online_result(conv.motion, ao, opt, result, online_cost_us, error)) return fail("--online: " + error);
+    shift_m = result.shift_m;
+  } else if (opt.correction == "waist") {
     balance::RobustFilterOptions ro;
     ro.analysis = ao;
     ro.margin_m = opt.margin_m;
@@ -235,6 +286,9 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
   for (const balance::Vec3& d : result.correction)
     report.max_correction_rad = std::max(report.max_correction_rad, d.norm());
   report.lookahead_frames = result.operator_band;
+  report.online = opt.online;
+  report.online_mean_us = online_cost_us[0];
+  report.online_max_us = online_cost_us[1];
   report.forward = travel_direction(conv.motion, result.before);
   if (!opt.csv.empty() && !write_zmp_csv(opt.csv, report, error)) return fail(error);
   if (!opt.json.empty() && !write_zmp_json(opt.json, report, error)) return fail(error);
@@ -259,7 +313,15 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
                b.frames_outside, b.frames, b.max_outside_m, b.rms_outside_m);
     fmt::print("  after:  ZMP outside the support polygon in {} of {} frames (max {:.3f} m), {} unsolved\n",
                a.frames_outside, a.frames, a.max_outside_m, result.frames_unsolved);
-    if (shift_m.empty()) {
+    if (opt.online) {
+      double shift = 0.0;
+      for (const balance::Vec2& s : shift_m) shift = std::max(shift, s.norm());
+      fmt::print(
+          "  correction (online, look-ahead {:.3f} s = {} frames): pelvis shift up to {:.1f} cm; feet down moved by at "
+          "most {:.2e} m; {:.0f} us per frame (max {:.0f} us)\n",
+          opt.lookahead_s, result.operator_band, 100.0 * shift, applied.max_foot_displacement_m, online_cost_us[0],
+          online_cost_us[1]);
+    } else if (shift_m.empty()) {
       fmt::print("  correction: waist rotation up to {:.3f} rad, feet moved by at most {:.2e} m, {} iterations\n",
                  report.max_correction_rad, applied.max_foot_displacement_m, result.iterations);
     } else {

@@ -28,6 +28,8 @@ struct ZmpCommandOptions {
   double cutoff_hz = 6.0;
   bool full_zmp = false;                // include the segments' angular momentum rate
   std::string correction = "rotation";  // rotation (waist rotation, one estimator) or waist (robust filter)
+  bool online = false;                  // the streaming filter (pelvis shift by preview control, bounded look-ahead)
+  double lookahead_s = 0.25;            // --online: how far ahead it sees, s (at most 0.25)
   double margin_m = 0.01;
   double max_correction_rad = 1.0;
   int max_iterations = 100;

@@ -142,6 +142,11 @@ bool write_zmp_json(const std::string& path, const ZmpReport& r, std::string& er
   out += fmt::format("  \"frames_zmp_undefined\": {},\n", b.frames_undefined);
   out += fmt::format("  \"iterations\": {},\n", f.iterations);
   out += fmt::format("  \"lookahead_frames\": {},\n", r.lookahead_frames);
+  out += fmt::format("  \"online\": {},\n", r.online ? "true" : "false");
+  if (r.online) {
+    out += fmt::format("  \"online_us_per_frame\": {{\"mean\": {:.1f}, \"max\": {:.1f}}},\n", r.online_mean_us,
+                       r.online_max_us);
+  }
   out += family_json(r.family_before, r.family_after);
   out += "}\n";
   return write_file(path, out, error);

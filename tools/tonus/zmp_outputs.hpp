@@ -25,6 +25,9 @@ struct ZmpReport {
   const balance::FamilyVerdict* family_after = nullptr;
   double max_correction_rad = 0.0;
   std::size_t lookahead_frames = 0;
+  bool online = false;          // the streaming filter made the correction
+  double online_mean_us = 0.0;  // its cost per frame
+  double online_max_us = 0.0;
   balance::Vec2 forward = balance::Vec2::UnitX();  // the plots' forward axis in the ground plane
 };
 

@@ -45,10 +45,10 @@ std::size_t flat_frame(const HumanMotion& m, const FootLandmarks& f) {
   return best;
 }
 
-Sole measure_sole(const HumanMotion& m, Foot foot, double ground_z, const ContactOptions& opt) {
+}  // namespace
+
+Sole measure_sole(const MotionFrame& fr, Foot foot, double ground_z, const ContactOptions& opt) {
   const FootLandmarks f = foot_landmarks(foot);
-  const std::size_t t0 = flat_frame(m, f);
-  const MotionFrame& fr = m.frames[t0];
   const Vec3 ankle = fr.p[index(f.ankle)], ball = fr.p[index(f.toe_joint)], tip = fr.p[index(f.toe_tip)];
   Vec2 fwd = horizontal(ball - ankle);
   if (fwd.norm() < 1e-6) fwd = Vec2(1, 0);
@@ -84,6 +84,8 @@ Sole measure_sole(const HumanMotion& m, Foot foot, double ground_z, const Contac
   s.toes = {in_toes(tip2 + 0.3 * w * side), in_toes(tip2 - 0.3 * w * side)};
   return s;
 }
+
+namespace {
 
 struct SoleWorld {
   std::vector<Vec3> rear, ball, toes;
@@ -164,7 +166,7 @@ ContactTrack detect_contacts(const HumanMotion& m, const ContactOptions& opt) {
   }
   for (const Foot foot : {Foot::left, Foot::right}) {
     const auto fi = static_cast<std::size_t>(foot);
-    track.soles[fi] = measure_sole(m, foot, track.ground_z_m, opt);
+    track.soles[fi] = measure_sole(m.frames[flat_frame(m, foot_landmarks(foot))], foot, track.ground_z_m, opt);
     // Heights and speeds of the heel and the ball over the clip.
     std::vector<Vec3> heel(m.size()), ball(m.size());
     for (std::size_t t = 0; t < m.size(); ++t) {
@@ -193,10 +195,15 @@ ContactTrack detect_contacts(const HumanMotion& m, const ContactOptions& opt) {
 }
 
 ConvexPolygon support_polygon(const ContactTrack& track, const MotionFrame& frame, std::size_t t) {
+  return support_polygon(track, frame, track.frames[t]);
+}
+
+ConvexPolygon support_polygon(const ContactTrack& track, const MotionFrame& frame,
+                              const std::array<FootContact, 2>& contacts) {
   std::vector<Vec2> pts;
   for (const Foot foot : {Foot::left, Foot::right}) {
     const auto fi = static_cast<std::size_t>(foot);
-    const FootContact c = track.frames[t][fi];
+    const FootContact c = contacts[fi];
     if (!c.any()) continue;
     const SoleWorld w = place(track.soles[fi], frame, foot);
     if (c.ball) {
@@ -223,6 +230,75 @@ std::vector<Vec2> sole_outline(const ContactTrack& track, const MotionFrame& fra
     for (const Vec3& p : *part) pts.push_back(horizontal(p));
   }
   return convex_hull(pts).vertices;
+}
+
+CausalContacts::CausalContacts(const ContactOptions& options, double dt_s)
+    : options_(options),
+      dt_s_(dt_s),
+      window_(std::max<std::size_t>(3, static_cast<std::size_t>(kRestWindow_s / dt_s))) {
+  lows_.assign(window_, 0.0);
+  for (auto& foot : points_) {
+    for (Point& p : foot) p.heights.assign(window_, 0.0);
+  }
+  scratch_.reserve(window_);
+  flattest_.fill(std::numeric_limits<double>::infinity());
+}
+
+double CausalContacts::percentile_of(const std::vector<double>& ring) const {
+  const std::size_t n = std::min(pushed_, window_);
+  scratch_.assign(ring.begin(), ring.begin() + static_cast<std::ptrdiff_t>(n));
+  const auto k = static_cast<std::size_t>(0.05 * static_cast<double>(n - 1));
+  std::nth_element(scratch_.begin(), scratch_.begin() + static_cast<std::ptrdiff_t>(k), scratch_.end());
+  return scratch_[k];
+}
+
+std::array<FootContact, 2> CausalContacts::push(const MotionFrame& frame) {
+  const std::size_t slot = pushed_ % window_;
+  double low = std::numeric_limits<double>::infinity();
+  for (const Foot foot : {Foot::left, Foot::right}) {
+    const FootLandmarks f = foot_landmarks(foot);
+    for (const Landmark l : {f.ankle, f.toe_joint, f.toe_tip}) low = std::min(low, frame.p[index(l)].z());
+  }
+  lows_[slot] = low;
+  ++pushed_;
+  track_.ground_z_m = options_.ground_z_m ? *options_.ground_z_m : percentile_of(lows_) - kSoleBelowLowestPoint;
+
+  std::array<FootContact, 2> out{};
+  for (const Foot foot : {Foot::left, Foot::right}) {
+    const auto fi = static_cast<std::size_t>(foot);
+    const FootLandmarks f = foot_landmarks(foot);
+    const Vec3 ankle = frame.p[index(f.ankle)], ball = frame.p[index(f.toe_joint)];
+    // Re-measure the sole on a flatter stance than any so far (the score of flat_frame).
+    const double speed =
+        pushed_ > 1 ? ((ankle - last_ankle_[fi]).norm() + (ball - last_ball_[fi]).norm()) / dt_s_ : 0.0;
+    const double score = ankle.z() + ball.z() + 0.05 * speed;
+    if (score < flattest_[fi]) {
+      flattest_[fi] = score;
+      track_.soles[fi] = measure_sole(frame, foot, track_.ground_z_m, options_);
+    }
+    last_ankle_[fi] = ankle;
+    last_ball_[fi] = ball;
+
+    const Quat foot_rot = frame.rotation[sim::index(foot == Foot::left ? sim::Bone::LeftFoot : sim::Bone::RightFoot)];
+    const std::array<Vec3, 2> now = {Vec3(ankle + foot_rot * mean(track_.soles[fi].rear)),
+                                     Vec3(ankle + foot_rot * mean(track_.soles[fi].ball))};
+    std::array<bool, 2> on{};
+    for (std::size_t k = 0; k < 2; ++k) {
+      Point& p = points_[fi][k];
+      p.heights[slot] = now[k].z();
+      const double rest = percentile_of(p.heights);
+      const double v = pushed_ > 2 ? (now[k] - p.before_last).norm() / (2.0 * dt_s_)
+                                   : (pushed_ > 1 ? (now[k] - p.last).norm() / dt_s_ : 0.0);
+      const double h = now[k].z() - rest;
+      p.on = p.on ? !(h > options_.height_off_m || v > options_.speed_off_mps)
+                  : (h < options_.height_on_m && v < options_.speed_on_mps);
+      p.before_last = p.last;
+      p.last = now[k];
+      on[k] = p.on;
+    }
+    out[fi] = {on[0], on[1]};
+  }
+  return out;
 }
 
 }  // namespace tonus::balance

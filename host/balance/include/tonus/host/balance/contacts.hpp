@@ -55,6 +55,53 @@ ContactTrack detect_contacts(const HumanMotion& motion, const ContactOptions& op
 
 // The support polygon of a frame (empty when airborne), in the ground plane.
 ConvexPolygon support_polygon(const ContactTrack& track, const MotionFrame& frame, std::size_t index);
+// The same from the frame's contacts given directly.
+ConvexPolygon support_polygon(const ContactTrack& track, const MotionFrame& frame,
+                              const std::array<FootContact, 2>& contacts);
+
+// The sole of one foot measured on one frame where it stands flat on the
+// ground at ground_z (what detect_contacts does on the flattest frame).
+Sole measure_sole(const MotionFrame& frame, Foot foot, double ground_z, const ContactOptions& options);
+
+// Streaming contact detection for the online balance filter: each frame's
+// contacts from that frame and the ones before it only. The same points,
+// thresholds and hysteresis as detect_contacts, with causal estimates in place
+// of the whole clip's: the ground is the 5th percentile of the lowest foot
+// point over the last 1.5 s (minus the 2 cm the tracked points sit above the
+// sole), each point's resting height the 5th percentile of its own heights
+// over the last 1.5 s, speeds backward differences over two frames (one frame
+// late), and each sole is measured again whenever its foot stands flatter than
+// it has so far (low and slow), so it settles at the first flat stance.
+// Its storage is sized once (1.5 s of frames); push allocates only when it
+// measures a sole again.
+class CausalContacts {
+ public:
+  CausalContacts(const ContactOptions& options, double dt_s);
+  // The contacts of this frame.
+  std::array<FootContact, 2> push(const MotionFrame& frame);
+  // The ground and soles so far (its `frames` stay empty).
+  [[nodiscard]] const ContactTrack& track() const { return track_; }
+  [[nodiscard]] std::size_t pushed() const { return pushed_; }
+
+ private:
+  struct Point {
+    std::vector<double> heights;  // ring over the window
+    Vec3 last = Vec3::Zero(), before_last = Vec3::Zero();
+    bool on = false;
+  };
+  [[nodiscard]] double percentile_of(const std::vector<double>& ring) const;
+
+  ContactOptions options_;
+  double dt_s_;
+  std::size_t window_;
+  std::size_t pushed_ = 0;
+  ContactTrack track_;
+  std::vector<double> lows_;                    // ring: the lowest foot point per frame
+  std::array<std::array<Point, 2>, 2> points_;  // [foot][heel, ball]
+  std::array<double, 2> flattest_{};            // per foot: the best flatness score so far
+  std::array<Vec3, 2> last_ankle_{}, last_ball_{};
+  mutable std::vector<double> scratch_;
+};
 
 // The world sole outline of one foot at a frame (all three parts), for plots.
 std::vector<Vec2> sole_outline(const ContactTrack& track, const MotionFrame& frame, Foot foot);

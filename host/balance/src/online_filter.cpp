@@ -1,0 +1,215 @@
+#include "tonus/host/balance/online_filter.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <span>
+#include <utility>
+
+#include "tonus/host/balance/filter.hpp"
+#include "tonus/host/balance/zmp.hpp"
+
+namespace tonus::balance {
+namespace {
+
+constexpr double kMaxDrop_m = 0.008;
+
+bool finite_frame(const MotionFrame& f) {
+  for (const Vec3& p : f.p) {
+    if (!p.allFinite()) return false;
+  }
+  return true;
+}
+
+// How much of a horizontal pelvis shift the whole body's centre of mass
+// follows at this frame (the legs bend to keep the feet, so less than 1).
+double shift_share(const MassModel& mass, const MotionFrame& f) {
+  constexpr double kProbe_m = 0.01;
+  const Vec3 c0 = centre_of_mass(mass, place_segments(mass, f.p));
+  const Vec3 cx = centre_of_mass(mass, place_segments(mass, correct_waist(f, Vec3::Zero(), Vec2(kProbe_m, 0.0)).p));
+  const double share = (cx.x() - c0.x()) / kProbe_m;
+  return std::clamp(share, 0.3, 1.0);
+}
+
+}  // namespace
+
+OnlineBalance::Created OnlineBalance::create(const OnlineOptions& o) {
+  Created c;
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (!positive(o.dt_s)) {
+    c.error = "dt_s must be finite and positive";
+  } else if (!positive(o.lookahead_s) || o.lookahead_s > kMaxLookahead_s + 1e-12) {
+    c.error = "the look-ahead must lie in (0, 0.25] s";
+  } else if (!positive(o.margin_m) || !positive(o.max_shift_m) || !positive(o.jerk_weight) ||
+             !positive(o.com_height_m)) {
+    c.error = "margin, shift cap, jerk weight and centre-of-mass height must be finite and positive";
+  }
+  if (!c.error.empty()) return c;
+  const auto lag = static_cast<std::size_t>(std::lround(o.lookahead_s / o.dt_s));
+  if (lag < 1) {
+    c.error = "the look-ahead is shorter than one frame";
+    return c;
+  }
+  derivatives::Params p = o.analysis.derivatives;
+  if (p.method != derivatives::Method::kalman) p.method = derivatives::Method::kalman;  // the fixed-lag form of both
+  auto smoother = derivatives::FixedLag3::create(o.dt_s, p, lag);
+  if (!smoother) {
+    c.error = "smoothing: " + std::string(derivatives::to_string(smoother.status.error));
+    return c;
+  }
+  PreviewOptions po;
+  po.dt_s = o.dt_s;
+  po.com_height_m = o.com_height_m;
+  po.preview_frames = lag;
+  po.jerk_weight = o.jerk_weight;
+  po.gravity = o.analysis.gravity;
+  PreviewModel preview = preview_model(po);
+  if (!preview.ok()) {
+    c.error = "preview control: " + preview.error;
+    return c;
+  }
+  c.filter.emplace(OnlineBalance(o, lag, *smoother.smoother, std::move(preview)));
+  return c;
+}
+
+OnlineBalance::OnlineBalance(const OnlineOptions& options, std::size_t lag, const derivatives::FixedLag3& smoother,
+                             PreviewModel preview)
+    : options_(options),
+      lag_(lag),
+      mass_(make_mass_model(options.analysis.body_mass_kg, options.analysis.sex)),
+      contacts_(options.analysis.contacts, options.dt_s),
+      segments_(kSegmentParts, smoother),
+      preview_(std::move(preview)),
+      frames_(lag + 1),
+      frame_contacts_(lag + 1),
+      placed_(lag + 1),
+      polygons_(lag + 1),
+      zmp_(lag + 1, Vec2::Zero()),
+      outside_(lag + 1, 0.0),
+      defined_(lag + 1, false) {
+  errors_[0].assign(lag + 1, 0.0);
+  errors_[1].assign(lag + 1, 0.0);
+}
+
+bool OnlineBalance::push(const MotionFrame& in, OnlineFrame& out) {
+  const std::size_t slot = pushed_ % (lag_ + 1);
+  if (finite_frame(in) || pushed_ == 0) {
+    frames_[slot] = in;
+  } else {
+    frames_[slot] = frames_[(pushed_ - 1) % (lag_ + 1)];
+    ++non_finite_;
+  }
+  const MotionFrame& f = frames_[slot];
+  frame_contacts_[slot] = contacts_.push(f);
+  const auto& c = frame_contacts_[slot];
+  polygons_[slot] = c[0].any() || c[1].any() ? support_polygon(contacts_.track(), f, c) : ConvexPolygon{};
+  placed_[slot] = place_segments(mass_, f.p);
+  const SegmentFrame& seg = placed_[slot];
+  for (std::size_t i = 0; i < kSegmentParts; ++i) segments_[i].push(seg[i].com);
+  ++pushed_;
+  if (pushed_ <= lag_) return false;
+  window_errors();
+  emit(lag_, out);
+  return true;
+}
+
+bool OnlineBalance::flush(OnlineFrame& out) {
+  if (pushed_ == 0 || emitted_ >= pushed_) return false;
+  const std::size_t back = pushed_ - 1 - emitted_;  // frames between it and the newest
+  window_errors();
+  emit(back, out);
+  return true;
+}
+
+// The ZMP error of every frame in the window, from the smoothers' current
+// estimates (the newest frame at frames_back 0).
+void OnlineBalance::window_errors() {
+  const std::size_t held = std::min(pushed_, lag_ + 1);
+  const double g = options_.analysis.gravity;
+  const double ground = contacts_.track().ground_z_m;
+  SegmentFrame seg{};
+  std::array<Vec3, kSegmentParts> acc{};
+  for (std::size_t w = 0; w < held; ++w) {  // w = 0: the oldest held
+    const std::size_t back = held - 1 - w;
+    const std::size_t k = pushed_ - 1 - back;
+    const SegmentFrame& placed = placed_[k % (lag_ + 1)];
+    bool valid = true;
+    for (std::size_t i = 0; i < kSegmentParts; ++i) {
+      const derivatives::Estimate3 e = segments_[i].estimate(back);
+      valid = valid && e.valid;
+      seg[i] = placed[i];
+      seg[i].com = e.valid ? e.pos : placed[i].com;
+      acc[i] = e.valid ? e.acc : Vec3::Zero();
+    }
+    ZmpInputs zi;
+    zi.segments = &seg;
+    zi.accel = &acc;
+    const ZmpResult z = zero_moment_point(mass_, zi, ground, g);
+    errors_[0][w] = errors_[1][w] = 0.0;
+    defined_[w] = valid && z.defined;
+    zmp_[w] = z.zmp;
+    outside_[w] = 0.0;
+    const ConvexPolygon& poly = polygons_[k % (lag_ + 1)];
+    if (!defined_[w] || poly.vertices.empty()) continue;
+    outside_[w] = signed_distance(poly, z.zmp);
+    if (outside_[w] > -options_.margin_m) {
+      const Vec2 target = nearest_point_inset(poly, z.zmp, options_.margin_m);
+      errors_[0][w] = target.x() - z.zmp.x();
+      errors_[1][w] = target.y() - z.zmp.y();
+    }
+  }
+}
+
+// Emits the frame `frames_back` before the newest; the window's position of
+// it is held - 1 - frames_back.
+void OnlineBalance::emit(std::size_t frames_back, OnlineFrame& out) {
+  const std::size_t held = std::min(pushed_, lag_ + 1);
+  const std::size_t w = held - 1 - frames_back;
+  const std::size_t k = pushed_ - 1 - frames_back;
+  const MotionFrame& f = frames_[k % (lag_ + 1)];
+  Vec2 offset;
+  for (std::size_t a = 0; a < 2; ++a) {
+    offset[static_cast<Eigen::Index>(a)] = cart_[a].x();
+    // The errors after this frame (at least one: the last is held).
+    const std::size_t first = std::min(w + 1, held - 1);
+    const std::span<const double> ahead(errors_[a].data() + first, held - first);
+    preview_step(preview_, cart_[a], ahead);
+  }
+  if (share_ <= 0.0) share_ = shift_share(mass_, f);  // once: it jumps where a leg straightens
+  const double share = share_;
+  Vec2 shift = offset / share;
+  out.shift_capped = false;
+  for (Eigen::Index a = 0; a < 2; ++a) {
+    if (std::abs(shift[a]) > options_.max_shift_m) {
+      shift[a] = std::copysign(options_.max_shift_m, shift[a]);
+      out.shift_capped = true;
+    }
+  }
+  bool reachable = true;
+  out.corrected = correct_waist(f, Vec3::Zero(), shift, &out.drop_m, &reachable);
+  // A straight stance leg makes the pelvis drop to keep its foot; a drop that
+  // comes and goes within a frame or two is a vertical jolt whose
+  // acceleration throws the ZMP far off. Shift less there instead.
+  if (out.drop_m > kMaxDrop_m) {
+    double lo = 0.0, hi = 1.0;
+    for (int i = 0; i < 6; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      double drop = 0.0;
+      (void)correct_waist(f, Vec3::Zero(), mid * shift, &drop, nullptr);
+      (drop > kMaxDrop_m ? hi : lo) = mid;
+    }
+    shift *= lo;
+    out.shift_capped = true;
+    out.corrected = correct_waist(f, Vec3::Zero(), shift, &out.drop_m, &reachable);
+  }
+  out.share = share;
+  out.index = k;
+  out.shift_m = shift;
+  out.contacts = frame_contacts_[k % (lag_ + 1)];
+  out.zmp_defined = defined_[w];
+  out.zmp_before = zmp_[w];
+  out.outside_before_m = outside_[w];
+  out.reachable = reachable;
+  ++emitted_;
+}
+
+}  // namespace tonus::balance
