@@ -74,7 +74,7 @@ TEST_CASE("online balance filter: a look-ahead over 0.25 s or under a frame, and
   CHECK(OnlineBalance::create(o).filter->lookahead_frames() == 30);  // 0.25 s at 120 Hz
 }
 
-TEST_CASE("online balance filter: every frame comes out once, in order, the look-ahead late; feet down stay") {
+TEST_CASE("online balance filter: every frame comes out once, in order, the look-ahead late, and feet down stay") {
   const test::Loaded l = test::load(test::bundled_clip("cmu_02_walk.bvh"));
   const HumanMotion& m = l.conversion.motion;
   const OnlineOptions o = options_for(m);
