@@ -20,6 +20,17 @@ constexpr double kRearFootShare = 0.25;         // heel-only contact: the rear q
 
 Vec2 horizontal(const Vec3& v) { return {v.x(), v.y()}; }
 
+Quat foot_rotation(const MotionFrame& fr, Foot foot) {
+  return fr.rotation[sim::index(foot == Foot::left ? sim::Bone::LeftFoot : sim::Bone::RightFoot)];
+}
+
+// How flat a foot stands: low ankle and ball, slow (lower is flatter); the
+// offline detection takes its sole from the flattest frame, the causal one
+// from the flattest so far.
+double flatness(const Vec3& ankle, const Vec3& ball, double speed_mps) {
+  return ankle.z() + ball.z() + 0.05 * speed_mps;
+}
+
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
   const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1));
@@ -36,7 +47,7 @@ std::size_t flat_frame(const HumanMotion& m, const FootLandmarks& f) {
     const double speed = ((m.frames[t + 1].p[index(f.ankle)] - m.frames[t - 1].p[index(f.ankle)]).norm() +
                           (m.frames[t + 1].p[index(f.toe_joint)] - m.frames[t - 1].p[index(f.toe_joint)]).norm()) /
                          (2.0 * m.dt_s);
-    const double score = a[index(f.ankle)].z() + a[index(f.toe_joint)].z() + 0.05 * speed;
+    const double score = flatness(a[index(f.ankle)], a[index(f.toe_joint)], speed);
     if (score < best_score) {
       best_score = score;
       best = t;
@@ -74,7 +85,7 @@ Sole measure_sole(const MotionFrame& fr, Foot foot, double ground_z, const Conta
   const Vec2 heel = a2 - kHeelBehindAnkle * length * fwd;
   const Vec2 ball2 = a2 + kBallAheadOfAnkle * length * fwd;
   const Vec2 tip2 = a2 + kTipAheadOfAnkle * length * fwd;
-  const Quat foot_rot = fr.rotation[sim::index(foot == Foot::left ? sim::Bone::LeftFoot : sim::Bone::RightFoot)];
+  const Quat foot_rot = foot_rotation(fr, foot);
   const Quat toes_rot = fr.rotation[sim::index(foot == Foot::left ? sim::Bone::LeftToes : sim::Bone::RightToes)];
   const auto in_foot = [&](const Vec2& p) { return Vec3(foot_rot.conjugate() * (on_ground(p) - ankle)); };
   const auto in_toes = [&](const Vec2& p) { return Vec3(toes_rot.conjugate() * (on_ground(p) - ball)); };
@@ -93,7 +104,7 @@ struct SoleWorld {
 
 SoleWorld place(const Sole& s, const MotionFrame& fr, Foot foot) {
   const FootLandmarks f = foot_landmarks(foot);
-  const Quat foot_rot = fr.rotation[sim::index(foot == Foot::left ? sim::Bone::LeftFoot : sim::Bone::RightFoot)];
+  const Quat foot_rot = foot_rotation(fr, foot);
   const Quat toes_rot = fr.rotation[sim::index(foot == Foot::left ? sim::Bone::LeftToes : sim::Bone::RightToes)];
   const Vec3 ankle = fr.p[index(f.ankle)], ball = fr.p[index(f.toe_joint)];
   SoleWorld w;
@@ -268,10 +279,10 @@ std::array<FootContact, 2> CausalContacts::push(const MotionFrame& frame) {
     const auto fi = static_cast<std::size_t>(foot);
     const FootLandmarks f = foot_landmarks(foot);
     const Vec3 ankle = frame.p[index(f.ankle)], ball = frame.p[index(f.toe_joint)];
-    // Re-measure the sole on a flatter stance than any so far (the score of flat_frame).
+    // Re-measure the sole on a flatter stance than any so far.
     const double speed =
         pushed_ > 1 ? ((ankle - last_ankle_[fi]).norm() + (ball - last_ball_[fi]).norm()) / dt_s_ : 0.0;
-    const double score = ankle.z() + ball.z() + 0.05 * speed;
+    const double score = flatness(ankle, ball, speed);
     if (score < flattest_[fi]) {
       flattest_[fi] = score;
       track_.soles[fi] = measure_sole(frame, foot, track_.ground_z_m, options_);
@@ -279,7 +290,7 @@ std::array<FootContact, 2> CausalContacts::push(const MotionFrame& frame) {
     last_ankle_[fi] = ankle;
     last_ball_[fi] = ball;
 
-    const Quat foot_rot = frame.rotation[sim::index(foot == Foot::left ? sim::Bone::LeftFoot : sim::Bone::RightFoot)];
+    const Quat foot_rot = foot_rotation(frame, foot);
     const std::array<Vec3, 2> now = {Vec3(ankle + foot_rot * mean(track_.soles[fi].rear)),
                                      Vec3(ankle + foot_rot * mean(track_.soles[fi].ball))};
     std::array<bool, 2> on{};

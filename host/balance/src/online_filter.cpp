@@ -50,7 +50,7 @@ OnlineBalance::Created OnlineBalance::create(const OnlineOptions& o) {
     return c;
   }
   derivatives::Params p = o.analysis.derivatives;
-  if (p.method != derivatives::Method::kalman) p.method = derivatives::Method::kalman;  // the fixed-lag form of both
+  p.method = derivatives::Method::kalman;  // the fixed-lag form of both Kalman methods
   auto smoother = derivatives::FixedLag3::create(o.dt_s, p, lag);
   if (!smoother) {
     c.error = "smoothing: " + std::string(derivatives::to_string(smoother.status.error));
