@@ -4,7 +4,6 @@
 #include <unistd.h>
 
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -124,37 +123,20 @@ bool online_result(const balance::HumanMotion& motion, const balance::AnalysisOp
   oo.dt_s = motion.dt_s;
   oo.lookahead_s = opt.lookahead_s;
   oo.margin_m = opt.margin_m > 0.0 ? opt.margin_m : 0.01;
-  auto created = balance::OnlineBalance::create(oo);
-  if (!created) {
-    error = created.error;
+  balance::OnlineRun run = balance::run_online(motion, oo);
+  if (!run.ok()) {
+    error = run.error;
     return false;
   }
-  balance::OnlineBalance& filter = *created.filter;
-  f.corrected = motion;
+  f.corrected = std::move(run.corrected);
   f.correction.assign(motion.size(), balance::Vec3::Zero());
-  f.shift_m.assign(motion.size(), balance::Vec2::Zero());
+  f.shift_m = std::move(run.shift_m);
   f.unsolved.assign(motion.size(), false);
-  balance::OnlineFrame out;
-  const auto take = [&] {
-    f.corrected.frames[out.index] = out.corrected;
-    f.shift_m[out.index] = out.shift_m;
-    f.max_drop_m = std::max(f.max_drop_m, out.drop_m);
-  };
-  double total_us = 0.0;
-  cost_us = {0.0, 0.0};
-  for (const balance::MotionFrame& frame : motion.frames) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const bool got = filter.push(frame, out);
-    const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
-    total_us += us;
-    cost_us[1] = std::max(cost_us[1], us);
-    if (got) take();
-  }
-  while (filter.flush(out)) take();
-  cost_us[0] = motion.size() > 0 ? total_us / static_cast<double>(motion.size()) : 0.0;
+  f.max_drop_m = run.max_drop_m;
+  cost_us = {run.mean_push_us, run.max_push_us};
   f.before = balance::analyse(motion, base);
   f.after = balance::analyse(f.corrected, base, &f.before.contacts);
-  f.operator_band = filter.lookahead_frames();
+  f.operator_band = run.lookahead_frames;
   return true;
 }
 

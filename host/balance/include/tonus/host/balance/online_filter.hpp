@@ -121,4 +121,20 @@ struct OnlineBalance::Created {
   explicit operator bool() const { return error.empty(); }
 };
 
+// A whole clip streamed through the filter, frame by frame, as a live source
+// would feed it: every frame comes out exactly as it would have live (nothing
+// beyond the look-ahead is used), so a clip known in advance can be corrected
+// at load and played.
+struct OnlineRun {
+  HumanMotion corrected;
+  std::vector<Vec2> shift_m;  // per frame
+  double max_drop_m = 0.0;
+  std::size_t lookahead_frames = 0;
+  std::size_t non_finite_frames = 0;
+  double mean_push_us = 0.0, max_push_us = 0.0;  // the cost of push(), wall clock
+  std::string error;                             // the options were refused; nothing ran
+  [[nodiscard]] bool ok() const { return error.empty(); }
+};
+OnlineRun run_online(const HumanMotion& motion, const OnlineOptions& options);
+
 }  // namespace tonus::balance

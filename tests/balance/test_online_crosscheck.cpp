@@ -1,0 +1,132 @@
+// The streaming balance filter judged from outside: its written clip under
+// the independent estimator (tests/balance/independent, no code shared with
+// the filter), and how far its result lands from the offline robust filter's
+// on the same clip, measured on the centre of mass both of them move.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "balance_fixtures.hpp"
+#include "independent/zmp_estimator.hpp"
+#include "support/sanitized.hpp"
+#include "tonus/host/balance/apply.hpp"
+#include "tonus/host/balance/mass_model.hpp"
+#include "tonus/host/balance/online_filter.hpp"
+#include "tonus/host/balance/robust_filter.hpp"
+
+namespace tonus::balance {
+namespace {
+
+struct Distance {
+  double rms_m = 0.0, max_m = 0.0;
+};
+
+// Horizontal distance between two motions' centres of mass, over the frames
+// from first_frame on.
+Distance com_distance(const HumanMotion& a, const HumanMotion& b, const MassModel& mass) {
+  Distance d;
+  std::size_t n = 0;
+  for (std::size_t t = a.first_frame; t < a.size(); ++t) {
+    const Vec3 ca = centre_of_mass(mass, place_segments(mass, a.frames[t].p));
+    const Vec3 cb = centre_of_mass(mass, place_segments(mass, b.frames[t].p));
+    const double e = (ca - cb).head<2>().norm();
+    d.rms_m += e * e;
+    d.max_m = std::max(d.max_m, e);
+    ++n;
+  }
+  d.rms_m = n > 0 ? std::sqrt(d.rms_m / static_cast<double>(n)) : 0.0;
+  return d;
+}
+
+struct Crosschecked {
+  std::size_t independent_before = 0, independent_after = 0, independent_supported = 0;
+  Distance online_to_offline, offline_edit, online_edit;
+};
+
+Crosschecked crosscheck(const std::string& name, const std::string& path, double unit_m, std::size_t first_frame) {
+  const test::Loaded l = test::load(path);
+  const HumanMotion& m = l.conversion.motion;
+  OnlineOptions oo;
+  oo.dt_s = m.dt_s;
+  const OnlineRun online = run_online(m, oo);
+  REQUIRE_MESSAGE(online.ok(), online.error);
+  const AppliedCorrection applied =
+      apply_correction(l.clip, l.conversion.geometry, m, std::vector<Vec3>(m.size(), Vec3::Zero()), online.shift_m);
+  REQUIRE_MESSAGE(applied.ok(), applied.error);
+  CHECK(applied.max_foot_displacement_m < 1e-3);  // the feet that carry weight stay
+  const motion::ReadResult back = motion::parse_bvh(motion::write_bvh(applied.clip, 6));
+  REQUIRE(back.ok());
+
+  indep::Options io;
+  io.metres_per_unit = unit_m;
+  io.first_frame = first_frame;
+  const indep::Estimate before = indep::estimate_zmp(l.clip, io), after = indep::estimate_zmp(back.clip, io);
+  REQUIRE(before.ok());
+  REQUIRE(after.ok());
+
+  const RobustFilterResult offline = robust_balance_filter(m, RobustFilterOptions{});
+  REQUIRE_MESSAGE(offline.ok(), offline.error);
+  const MassModel mass = make_mass_model(oo.analysis.body_mass_kg, oo.analysis.sex);
+  Crosschecked c;
+  c.independent_before = before.summary.outside;
+  c.independent_after = after.summary.outside;
+  c.independent_supported = after.summary.supported;
+  c.online_to_offline = com_distance(online.corrected, offline.corrected, mass);
+  c.offline_edit = com_distance(m, offline.corrected, mass);
+  c.online_edit = com_distance(m, online.corrected, mass);
+  MESSAGE(name << ": online filter (look-ahead " << online.lookahead_frames << " frames): independent estimator "
+               << c.independent_before << " -> " << c.independent_after << " of " << c.independent_supported
+               << " supported frames outside by more than 1 cm; centre of mass from the offline (robust) result: RMS "
+               << 100.0 * c.online_to_offline.rms_m << " cm, max " << 100.0 * c.online_to_offline.max_m
+               << " cm; the edits themselves: offline RMS " << 100.0 * c.offline_edit.rms_m << " cm (max "
+               << 100.0 * c.offline_edit.max_m << "), online RMS " << 100.0 * c.online_edit.rms_m << " cm (max "
+               << 100.0 * c.online_edit.max_m << ")");
+  return c;
+}
+
+}  // namespace
+
+// Measured (release build, ctest -R crosschecked -V): the independent
+// estimator's count before -> after, and the centre of mass's distance from
+// the offline result (RMS, max). The ceilings sit a little above them, so a
+// regression fails; they are not the goal, which the online filter
+// does not meet yet (docs/balance.md, "The online filter").
+TEST_CASE("online balance filter, crosschecked: Bandai walk, fewer frames outside, within 2.5 cm RMS of offline" *
+          tonus::test::heavy_under_sanitizers()) {
+  // 140 -> 99 of 195; 2.07 cm RMS, 7.6 max.
+  const Crosschecked c =
+      crosscheck("Bandai walk", test::shared_clip("dataset-1_walk_normal_001.bvh"), indep::kCentimetre_m, 0);
+  CHECK(c.independent_after < c.independent_before);
+  CHECK(c.independent_after <= 105);
+  CHECK(c.online_to_offline.rms_m < 0.025);
+  CHECK(c.online_to_offline.max_m < 0.09);
+}
+
+TEST_CASE("online balance filter, crosschecked: Bandai kicks, fewer frames outside, within 4.5 cm RMS of offline" *
+          tonus::test::heavy_under_sanitizers()) {
+  // 131 -> 120 of 358; 4.07 cm RMS, 14.3 max.
+  const Crosschecked c =
+      crosscheck("Bandai kicks", test::shared_clip("dataset-1_kick_normal_001.bvh"), indep::kCentimetre_m, 0);
+  CHECK(c.independent_after < c.independent_before);
+  CHECK(c.independent_after <= 126);
+  CHECK(c.online_to_offline.rms_m < 0.045);
+  CHECK(c.online_to_offline.max_m < 0.16);
+}
+
+TEST_CASE(
+    "online balance filter, crosschecked: CMU walk, within 3 cm RMS of offline (and worse under the "
+    "independent estimator)" *
+    tonus::test::heavy_under_sanitizers()) {
+  // 73 -> 109 of 343: the correction pushes more frames outside than it
+  // brings in under this estimator (the family's 6 Hz member: 122 -> 103).
+  // 2.76 cm RMS, 5.7 max.
+  const Crosschecked c = crosscheck("CMU walk", test::bundled_clip("cmu_02_walk.bvh"), indep::kCmuUnit_m, 1);
+  CHECK(c.independent_after <= 115);
+  CHECK(c.online_to_offline.rms_m < 0.03);
+  CHECK(c.online_to_offline.max_m < 0.065);
+}
+
+}  // namespace tonus::balance
