@@ -53,6 +53,11 @@ TEST_CASE("config: a bad value names the key and the value, and nothing is accep
       {"[band]\nstale_after_ms = -5\n", "band.stale_after_ms = -5"},
       {"[tracker]\nlisten_port = 70000\n", "tracker.listen_port = 70000"},
       {"[tracker]\ndelay_ms = 5000\n", "tracker.delay_ms = 5000"},
+      {"[tracker]\nbalance = \"on\"\n", "tracker.balance = \"on\": must be one of off, offline, online"},
+      {"[tracker]\nbalance_lookahead_ms = 400\n", "tracker.balance_lookahead_ms = 400: must be 1..250"},
+      {"[tracker]\nsource = \"vmc\"\nbalance = \"online\"\n",
+       "tracker.balance = \"online\": the balance filter runs "
+       "on a bvh source only"},
       {"[log]\nlevel = \"loud\"\n", "log.level = \"loud\""},
       {"[demo]\ngifts = [ { at_s = 1, kind = \"piano\", bone = \"Head\" } ]\n", "demo.gifts[0].kind = \"piano\""},
       {"[demo]\ngifts = [ { at_s = 1, kind = \"ball\", bone = \"Tail\" } ]\n", "demo.gifts[0].bone = \"Tail\""},
@@ -91,6 +96,11 @@ TEST_CASE("config: keys read over the defaults, the printed config reads back to
   REQUIRE(c.demo.gifts.size() == 1);
   CHECK(c.demo.gifts[0].bone == "Head");
   CHECK(c.output.port == 39539);  // untouched keys keep their defaults
+  CHECK(c.tracker.balance == tonus::balance::BalanceMode::off);
+  REQUIRE(parse_config("[tracker]\nsource = \"bvh\"\nbalance = \"online\"\nbalance_lookahead_ms = 100\n", "b.toml", c)
+              .empty());
+  CHECK(c.tracker.balance == tonus::balance::BalanceMode::online);
+  CHECK(c.tracker.balance_lookahead_s == doctest::Approx(0.1));
 
   const std::string printed = to_toml(c);
   DaemonConfig back;
@@ -101,6 +111,8 @@ TEST_CASE("config: keys read over the defaults, the printed config reads back to
   CHECK(back.band.stiffness.stale_after_s == doctest::Approx(c.band.stiffness.stale_after_s));
   CHECK(back.demo.gifts[0].at_s == 2.5);
   CHECK(back.band.sim_args == c.band.sim_args);
+  CHECK(back.tracker.balance == tonus::balance::BalanceMode::online);
+  CHECK(back.tracker.balance_lookahead_s == doctest::Approx(0.1));
 }
 
 namespace {

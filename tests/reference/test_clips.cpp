@@ -4,6 +4,9 @@
 // quaternion unit and continuous.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "reference_checks.hpp"
 
 using namespace tonus::reference;
@@ -67,4 +70,33 @@ TEST_CASE("reference: Bandai Namco run") {
 }
 TEST_CASE("reference: Bandai Namco wave") {
   check_clip("dataset-2_wave", test::shared_clip("dataset-2_wave-both-hands_normal_001.bvh"));
+}
+
+TEST_CASE("reference: the balance stage before retargeting (tonusd's tracker.balance)") {
+  const std::string path = test::bundled_clip("cmu_02_walk.bvh");
+  const ClipReference off = clip_to_reference(test::humanoid(), path);
+  REQUIRE_MESSAGE(off.ok(), off.error);
+  CHECK(off.balance.empty());
+  tonus::balance::BalanceStageOptions o;
+  o.mode = tonus::balance::BalanceMode::online;
+  const ClipReference online = clip_to_reference(test::humanoid(), path, o);
+  REQUIRE_MESSAGE(online.ok(), online.error);
+  MESSAGE(online.balance);
+  CHECK(online.balance.find("balance (online, look-ahead 30 frames)") == 0);
+  CHECK(std::find(online.messages.begin(), online.messages.end(), online.balance) != online.messages.end());
+  REQUIRE(online.qpos.size() == off.qpos.size());
+  // The pelvis moves sideways and back by at most the filter's cap (8 cm per
+  // axis, scaled onto the humanoid), and the root follows it.
+  double largest_m = 0.0;
+  for (std::size_t t = 0; t < off.qpos.size(); ++t) {
+    largest_m = std::max(largest_m, std::hypot(online.qpos[t][0] - off.qpos[t][0], online.qpos[t][1] - off.qpos[t][1]));
+  }
+  MESSAGE("largest root shift " << largest_m << " m");
+  CHECK(largest_m > 0.005);
+  CHECK(largest_m < 0.08 * std::sqrt(2.0) * 1.2);
+
+  o.lookahead_s = 0.5;
+  const ClipReference refused = clip_to_reference(test::humanoid(), path, o);
+  CHECK_FALSE(refused.ok());
+  CHECK(refused.error.find(path + ": online balance filter") == 0);
 }

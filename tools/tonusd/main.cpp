@@ -40,7 +40,7 @@ int run(int argc, char** argv) {
   double seconds = -1.0;
   // Flags that override the file (each names its key in docs/daemon.md).
   std::string band_source, band_socket, sim_synthetic, tracker_source, bvh_path, vmc_mode, vmc_host, listen_address,
-      log_level, candump_path;
+      log_level, candump_path, balance_mode;
   std::vector<std::string> sim_args;
   int vmc_port = -1, listen_port = -1, control_port = -1;
   double vmc_rate = -1.0, rate_hz = -1.0;
@@ -68,6 +68,8 @@ int run(int argc, char** argv) {
       ->allow_extra_args(false);
   app.add_option("--tracker", tracker_source, "tracker.source: bvh, vmc, none");
   app.add_option("--bvh", bvh_path, "tracker.bvh_path: the clip to play");
+  app.add_option("--balance", balance_mode,
+                 "tracker.balance: off, offline, online (the ZMP balance filter on the clip)");
   app.add_option("--vmc-mode", vmc_mode, "tracker.vmc_mode: performer, trackers");
   app.add_option("--listen-address", listen_address, "tracker.listen_address");
   app.add_option("--listen-port", listen_port, "tracker.listen_port (VMC in; 0: any free port)");
@@ -140,7 +142,8 @@ int run(int argc, char** argv) {
     const char* flag;
   } enum_flags[] = {{band_source, "band", "source", "--band"},
                     {tracker_source, "tracker", "source", "--tracker"},
-                    {vmc_mode, "tracker", "vmc_mode", "--vmc-mode"}};
+                    {vmc_mode, "tracker", "vmc_mode", "--vmc-mode"},
+                    {balance_mode, "tracker", "balance", "--balance"}};
   for (const auto& f : enum_flags) {
     if (f.value.empty()) continue;
     const std::string text = fmt::format("[{}]\n{} = \"{}\"\n", f.table, f.key, f.value);

@@ -64,6 +64,14 @@ std::string validate(const DaemonConfig& c) {
   const TrackerConfig& t = c.tracker;
   if (std::string e = validate_port("tracker.listen_port", t.listen_port, true); !e.empty()) return e;
   if (t.listen_address.empty()) return "tracker.listen_address = \"\": an address is needed";
+  if (t.balance != balance::BalanceMode::off && t.source != TrackerSource::bvh) {
+    return fmt::format(
+        "tracker.balance = \"{}\": the balance filter runs on a bvh source only (tracker.source = \"{}\")",
+        balance::to_string(t.balance), to_string(t.source));
+  }
+  if (!in(t.balance_lookahead_s, 0.001, balance::kMaxLookahead_s)) {
+    return bad("tracker.balance_lookahead_ms", t.balance_lookahead_s * 1e3, "must be 1..250");
+  }
   if (std::string e = validate(t.buffer); !e.empty()) return e;
   const PhysicsConfig& p = c.physics;
   if (!in(p.rate_hz, 100.0, 4000.0)) return bad("physics.rate_hz", p.rate_hz, "must be 100..4000");

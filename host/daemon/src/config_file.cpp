@@ -157,6 +157,8 @@ constexpr std::array kBandSources{BandSource::sim, BandSource::socket,  BandSour
                                   BandSource::can, BandSource::candump, BandSource::none};
 constexpr std::array kSimLinks{SimLink::hid, SimLink::can};
 constexpr std::array kTrackerSources{TrackerSource::bvh, TrackerSource::vmc, TrackerSource::none};
+constexpr std::array kBalanceModes{balance::BalanceMode::off, balance::BalanceMode::offline,
+                                   balance::BalanceMode::online};
 constexpr std::array kVmcModes{VmcMode::performer, VmcMode::trackers};
 constexpr std::array kFeedforwards{FeedforwardChoice::simulation, FeedforwardChoice::inverse_dynamics,
                                    FeedforwardChoice::none};
@@ -219,6 +221,8 @@ std::string read_all(const toml::table& root, DaemonConfig& c) {
     r.get_enum("source", t.source, kTrackerSources);
     r.get("bvh_path", t.bvh_path);
     r.get("bvh_loop", t.bvh_loop);
+    r.get_enum("balance", t.balance, kBalanceModes);
+    r.get_ms("balance_lookahead_ms", t.balance_lookahead_s);
     r.get_enum("vmc_mode", t.vmc_mode, kVmcModes);
     r.get("listen_address", t.listen_address);
     r.get("listen_port", t.listen_port);
@@ -347,6 +351,8 @@ std::string to_toml(const DaemonConfig& c) {
   out += "\n[tracker]\n";
   out += fmt::format("source = \"{}\"  # bvh, vmc, none\n", to_string(t.source));
   out += fmt::format("bvh_path = {}  # empty: the bundled clip\nbvh_loop = {}\n", q(t.bvh_path), t.bvh_loop);
+  out += fmt::format("balance = \"{}\"  # off, offline, online (bvh only)\nbalance_lookahead_ms = {}\n",
+                     balance::to_string(t.balance), t.balance_lookahead_s * 1e3);
   out += fmt::format("vmc_mode = \"{}\"  # performer, trackers\n", to_string(t.vmc_mode));
   out += fmt::format("listen_address = {}\nlisten_port = {}\n", q(t.listen_address), t.listen_port);
   out += fmt::format("delay_ms = {}\nhold_ms = {}\nease_ms = {}\nrecover_ms = {}\n", t.buffer.delay_s * 1e3,

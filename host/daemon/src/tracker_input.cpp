@@ -43,7 +43,10 @@ bool TrackerInput::start(std::string& error) {
   stop_.store(false);
   if (config_.source == TrackerSource::bvh) {
     const std::string path = config_.bvh_path.empty() ? default_bvh_path() : config_.bvh_path;
-    clip_ = reference::clip_to_reference(model_, path);
+    balance::BalanceStageOptions balance;
+    balance.mode = config_.balance;
+    balance.lookahead_s = config_.balance_lookahead_s;
+    clip_ = reference::clip_to_reference(model_, path, balance);
     if (!clip_.ok()) {
       error = fmt::format("tracker.bvh_path = \"{}\": {}", path, clip_.error);
       return false;
@@ -58,6 +61,7 @@ bool TrackerInput::start(std::string& error) {
                                    1.0 / clip_.dt_s, config_.bvh_loop ? ", looping" : "");
     }
     spdlog::info("tracker: {}", status_.source);
+    if (!clip_.balance.empty()) spdlog::info("tracker: {}", clip_.balance);
     thread_ = std::thread([this] { run_bvh(); });
     return true;
   }

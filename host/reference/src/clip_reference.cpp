@@ -162,6 +162,11 @@ ClipReference clip_to_reference(const sim::Model& humanoid, const balance::Human
 }
 
 ClipReference clip_to_reference(const sim::Model& humanoid, const std::string& bvh_path) {
+  return clip_to_reference(humanoid, bvh_path, balance::BalanceStageOptions{});
+}
+
+ClipReference clip_to_reference(const sim::Model& humanoid, const std::string& bvh_path,
+                                const balance::BalanceStageOptions& balance) {
   ClipReference r;
   try {
     motion::ReadResult read = motion::read_bvh_file(bvh_path);
@@ -180,12 +185,29 @@ ClipReference clip_to_reference(const sim::Model& humanoid, const std::string& b
       r.error = bvh_path + ": " + conv.error;
       return r;
     }
-    r = retarget(humanoid, conv.motion);
+    const balance::BalanceStageResult balanced = balance::balance_stage(conv.motion, balance);
+    if (!balanced.ok()) {
+      r.error = bvh_path + ": " + balanced.error;
+      return r;
+    }
+    r = retarget(humanoid, balanced.motion);
+    std::string balance_note;
     std::vector<std::string> notes;  // the reading's and the conversion's first
     for (const motion::Diagnostic& w : read.warnings) notes.push_back("bvh: " + w.message);
     notes.insert(notes.end(), conv.messages.begin(), conv.messages.end());
+    if (balance.mode != balance::BalanceMode::off) {
+      std::string mode(balance::to_string(balance.mode));
+      if (balance.mode == balance::BalanceMode::online) {
+        mode += ", look-ahead " + std::to_string(balanced.lookahead_frames) + " frames";
+      }
+      balance_note = "balance (" + mode + "): supported frames with the ZMP outside by more than 1 cm: " +
+                     std::to_string(balanced.frames_outside_before) + " -> " +
+                     std::to_string(balanced.frames_outside_after) + " of " + std::to_string(balanced.supported_frames);
+      notes.push_back(balance_note);
+    }
     notes.insert(notes.end(), r.messages.begin(), r.messages.end());
     r.messages = std::move(notes);
+    r.balance = std::move(balance_note);
   } catch (const std::exception& e) {
     r = ClipReference{};
     r.error = bvh_path + ": retargeting failed: " + e.what();

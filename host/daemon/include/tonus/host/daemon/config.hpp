@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "tonus/host/balance/stage.hpp"
 #include "tonus/host/daemon/pose_buffer.hpp"
 #include "tonus/host/daemon/stiffness_input.hpp"
 
@@ -51,6 +52,12 @@ struct TrackerConfig {
   TrackerSource source = TrackerSource::bvh;
   std::string bvh_path;  // empty: the bundled clip (tests/data/cmu_02_walk.bvh)
   bool bvh_loop = true;
+  // bvh: the balance filter on the clip before it plays (docs/balance.md):
+  // off, offline (the whole clip at load) or online (the streaming filter,
+  // balance_lookahead_s ahead; run over the clip at load, which gives what a
+  // live stream through it would).
+  balance::BalanceMode balance = balance::BalanceMode::off;
+  double balance_lookahead_s = balance::kMaxLookahead_s;
   VmcMode vmc_mode = VmcMode::performer;
   std::string listen_address = "127.0.0.1";
   int listen_port = 39540;

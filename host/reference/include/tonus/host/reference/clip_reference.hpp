@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "tonus/host/balance/landmarks.hpp"
+#include "tonus/host/balance/stage.hpp"
 #include "tonus/sim/capacity.hpp"
 #include "tonus/sim/human_bones.hpp"
 #include "tonus/sim/model.hpp"
@@ -36,7 +37,8 @@ struct ClipReference {
   std::array<std::size_t, sim::kBoneCount> clamped_frames{};  // per joint (Bone order): frames clamped into its limits
   std::size_t frames_clamped = 0;                             // frames with any joint clamped
   std::vector<std::string> messages;                          // what was assumed, measured and clamped
-  std::string error;                                          // non-empty: no configurations were made
+  std::string balance;  // the balance stage's figures, also among the messages (empty: the stage was off)
+  std::string error;    // non-empty: no configurations were made
 
   [[nodiscard]] bool ok() const { return error.empty(); }
 };
@@ -50,5 +52,11 @@ ClipReference clip_to_reference(const sim::Model& humanoid, const balance::Human
 // (balance::convert_motion, unit guessed) and retargets it; any failure on
 // the way is the error.
 ClipReference clip_to_reference(const sim::Model& humanoid, const std::string& bvh_path);
+
+// The same, with the balance filter run on the clip's motion before it is
+// retargeted (balance::balance_stage; off: as above). Its figures go to
+// `messages`; a refusal by the filter is the error.
+ClipReference clip_to_reference(const sim::Model& humanoid, const std::string& bvh_path,
+                                const balance::BalanceStageOptions& balance);
 
 }  // namespace tonus::reference
