@@ -42,6 +42,8 @@ OnlineBalance::Created OnlineBalance::create(const OnlineOptions& o) {
   } else if (!positive(o.margin_m) || !positive(o.max_shift_m) || !positive(o.jerk_weight) ||
              !positive(o.com_height_m)) {
     c.error = "margin, shift cap, jerk weight and centre-of-mass height must be finite and positive";
+  } else if (!(o.max_fine_shift_m >= 0.0 && o.max_fine_shift_m <= o.max_shift_m)) {
+    c.error = "the fine shift cap must lie in [0, shift cap]";
   }
   if (!c.error.empty()) return c;
   const auto lag = static_cast<std::size_t>(std::lround(o.lookahead_s / o.dt_s));
@@ -184,6 +186,22 @@ void OnlineBalance::emit(std::size_t frames_back, OnlineFrame& out) {
       out.shift_capped = true;
     }
   }
+  // The fine layer: the frame's centre of mass onto the smoothed one.
+  Vec2 fine = Vec2::Zero();
+  if (options_.max_fine_shift_m > 0.0) {
+    SegmentFrame smoothed = placed_[k % (lag_ + 1)];
+    bool valid = true;
+    for (std::size_t i = 0; i < kSegmentParts; ++i) {
+      const derivatives::Estimate3 e = segments_[i].estimate(frames_back);
+      valid = valid && e.valid;
+      if (e.valid) smoothed[i].com = e.pos;
+    }
+    if (valid) {
+      const Vec3 d = centre_of_mass(mass_, smoothed) - centre_of_mass(mass_, placed_[k % (lag_ + 1)]);
+      fine = (d.head<2>() / share).cwiseMax(-options_.max_fine_shift_m).cwiseMin(options_.max_fine_shift_m);
+    }
+  }
+  shift += fine;
   bool reachable = true;
   out.corrected = correct_waist(f, Vec3::Zero(), shift, &out.drop_m, &reachable);
   // A straight stance leg makes the pelvis drop to keep its foot; a drop that
@@ -204,6 +222,7 @@ void OnlineBalance::emit(std::size_t frames_back, OnlineFrame& out) {
   out.share = share;
   out.index = k;
   out.shift_m = shift;
+  out.fine_shift_m = fine;
   out.contacts = frame_contacts_[k % (lag_ + 1)];
   out.zmp_defined = defined_[w];
   out.zmp_before = zmp_[w];

@@ -45,6 +45,11 @@ struct OnlineOptions {
   double lookahead_s = 0.25;  // (0, kMaxLookahead_s]
   double margin_m = 0.015;    // the ZMP is brought this far inside its polygon
   double max_shift_m = 0.08;  // the pelvis's horizontal shift, either axis
+  // A fine layer of pelvis shift, at most this much per axis, that takes
+  // capture jitter out of the centre of mass: it moves the frame's centre of
+  // mass onto the smoothers' estimate at full look-ahead, the path the ZMP
+  // errors were computed on (0: off). The robust filter's fine layer, online.
+  double max_fine_shift_m = 0.005;
   double jerk_weight = 1e-6;  // preview control's R / Q (Kajita's)
   double com_height_m = 0.9;  // the cart-table's height: the centre of mass above the ground, standing
 };
@@ -53,7 +58,8 @@ struct OnlineOptions {
 struct OnlineFrame {
   std::size_t index = 0;  // which pushed frame (0 = the first)
   MotionFrame corrected;
-  Vec2 shift_m = Vec2::Zero();  // the pelvis's horizontal shift applied
+  Vec2 shift_m = Vec2::Zero();       // the pelvis's horizontal shift applied (the fine layer included)
+  Vec2 fine_shift_m = Vec2::Zero();  // of it, the fine layer
   std::array<FootContact, 2> contacts{};
   bool zmp_defined = false;
   Vec2 zmp_before = Vec2::Zero();  // the input's ZMP as the window saw it
