@@ -168,14 +168,7 @@ void OnlineBalance::emit(std::size_t frames_back, OnlineFrame& out) {
   const std::size_t w = held - 1 - frames_back;
   const std::size_t k = pushed_ - 1 - frames_back;
   const MotionFrame& f = frames_[k % (lag_ + 1)];
-  Vec2 offset;
-  for (std::size_t a = 0; a < 2; ++a) {
-    offset[static_cast<Eigen::Index>(a)] = cart_[a].x();
-    // The errors after this frame (at least one: the last is held).
-    const std::size_t first = std::min(w + 1, held - 1);
-    const std::span<const double> ahead(errors_[a].data() + first, held - first);
-    preview_step(preview_, cart_[a], ahead);
-  }
+  const Vec2 offset(cart_[0].x(), cart_[1].x());
   if (share_ <= 0.0) share_ = shift_share(mass_, f);  // once: it jumps where a leg straightens
   const double share = share_;
   Vec2 shift = offset / share;
@@ -218,6 +211,17 @@ void OnlineBalance::emit(std::size_t frames_back, OnlineFrame& out) {
     shift *= lo;
     out.shift_capped = true;
     out.corrected = correct_waist(f, Vec3::Zero(), shift, &out.drop_m, &reachable);
+  }
+  // Anti-windup: where the cap or the leg's reach held the shift back, the
+  // cart goes on from where the body is, not from where it was asked to be
+  // (else it overshoots when the limit lets go, which is a jolt).
+  const Vec2 applied = (shift - fine) * share;
+  for (std::size_t a = 0; a < 2; ++a) {
+    if (options_.anti_windup) cart_[a].x() = applied[static_cast<Eigen::Index>(a)];
+    // The errors after this frame (at least one: the last is held).
+    const std::size_t first = std::min(w + 1, held - 1);
+    const std::span<const double> ahead(errors_[a].data() + first, held - first);
+    preview_step(preview_, cart_[a], ahead);
   }
   out.share = share;
   out.index = k;

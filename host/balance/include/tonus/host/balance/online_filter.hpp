@@ -50,6 +50,10 @@ struct OnlineOptions {
   // mass onto the smoothers' estimate at full look-ahead, the path the ZMP
   // errors were computed on (0: off). The robust filter's fine layer, online.
   double max_fine_shift_m = 0.005;
+  // Where the cap or a straight leg holds the shift back, the preview's cart
+  // goes on from the shift applied, not the one asked for (false: it winds
+  // up, and overshoots when the limit lets go).
+  bool anti_windup = true;
   double jerk_weight = 1e-6;  // preview control's R / Q (Kajita's)
   double com_height_m = 0.9;  // the cart-table's height: the centre of mass above the ground, standing
 };
