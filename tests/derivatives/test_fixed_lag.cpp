@@ -3,6 +3,7 @@
 // result as the lag grows, and no allocation after create().
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -82,6 +83,40 @@ TEST_CASE("at the end of a stream, estimate(back) gives the rest of the batch re
   for (std::size_t i = y.size() - lag - 1; i < y.size(); ++i) worst = std::max(worst, scaled(out[i], batch, i, dt));
   CHECK(worst < 1e-10);
   CHECK(!f.estimate(lag + 1).valid);  // not kept
+}
+
+TEST_CASE("estimate_window is estimate(back) for every back, to the bit, and invalid where estimate is") {
+  const double dt = 1.0 / 120;
+  std::vector<double> y = noisy_walk(120, 70, 7);
+  y[30] = kNaN;
+  const std::size_t lag = 12;
+  auto f = FixedLag::create(dt, {}, lag).smoother;
+  auto f3 = FixedLag3::create(dt, {}, lag).smoother;
+  std::array<Estimate, lag + 3> window{};  // deeper than the lag: the extra ones invalid
+  std::array<Estimate3, lag + 3> window3{};
+  std::size_t compared = 0;
+  for (const double v : y) {
+    f->push(v);
+    f3->push(Eigen::Vector3d(v, -2.0 * v, 0.5));
+    f->estimate_window(window);
+    f3->estimate_window(window3);
+    for (std::size_t back = 0; back < window.size(); ++back) {
+      const Estimate e = f->estimate(back);
+      const Estimate3 e3 = f3->estimate(back);
+      CHECK(window[back].valid == e.valid);
+      CHECK(window3[back].valid == e3.valid);
+      if (!e.valid) continue;
+      CHECK(window[back].index == e.index);
+      CHECK(window[back].pos == e.pos);
+      CHECK(window[back].vel == e.vel);
+      CHECK(window[back].acc == e.acc);
+      CHECK(window3[back].acc == e3.acc);
+      CHECK(window3[back].pos == e3.pos);
+      ++compared;
+    }
+  }
+  CHECK(compared > 500);
+  f->estimate_window({});  // nothing asked: nothing done
 }
 
 TEST_CASE("the fixed-lag result converges to the full batch result as the lag grows") {

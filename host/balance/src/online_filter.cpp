@@ -85,6 +85,7 @@ OnlineBalance::OnlineBalance(const OnlineOptions& options, std::size_t lag, cons
       frame_contacts_(lag + 1),
       placed_(lag + 1),
       polygons_(lag + 1),
+      window_(kSegmentParts * (lag + 1)),
       zmp_(lag + 1, Vec2::Zero()),
       outside_(lag + 1, 0.0),
       defined_(lag + 1, false) {
@@ -130,13 +131,17 @@ void OnlineBalance::window_errors() {
   const double ground = contacts_.track().ground_z_m;
   SegmentFrame seg{};
   std::array<Vec3, kSegmentParts> acc{};
+  // Each smoother's whole window in one backward pass.
+  for (std::size_t i = 0; i < kSegmentParts; ++i) {
+    segments_[i].estimate_window(std::span<derivatives::Estimate3>(window_.data() + i * (lag_ + 1), held));
+  }
   for (std::size_t w = 0; w < held; ++w) {  // w = 0: the oldest held
     const std::size_t back = held - 1 - w;
     const std::size_t k = pushed_ - 1 - back;
     const SegmentFrame& placed = placed_[k % (lag_ + 1)];
     bool valid = true;
     for (std::size_t i = 0; i < kSegmentParts; ++i) {
-      const derivatives::Estimate3 e = segments_[i].estimate(back);
+      const derivatives::Estimate3& e = window_[i * (lag_ + 1) + back];
       valid = valid && e.valid;
       seg[i] = placed[i];
       seg[i].com = e.valid ? e.pos : placed[i].com;
@@ -185,7 +190,7 @@ void OnlineBalance::emit(std::size_t frames_back, OnlineFrame& out) {
     SegmentFrame smoothed = placed_[k % (lag_ + 1)];
     bool valid = true;
     for (std::size_t i = 0; i < kSegmentParts; ++i) {
-      const derivatives::Estimate3 e = segments_[i].estimate(frames_back);
+      const derivatives::Estimate3& e = window_[i * (lag_ + 1) + frames_back];
       valid = valid && e.valid;
       if (e.valid) smoothed[i].com = e.pos;
     }

@@ -1,5 +1,7 @@
 #include "tonus/host/derivatives/fixed_lag.hpp"
 
+#include <algorithm>
+
 namespace tonus::derivatives {
 
 FixedLag::Created FixedLag::create(double dt_s, const Params& params, std::size_t lag) {
@@ -47,6 +49,26 @@ Estimate FixedLag::estimate(std::size_t frames_back) const {
   return e;
 }
 
+void FixedLag::estimate_window(std::span<Estimate> out) const {
+  for (Estimate& e : out) e = Estimate{};
+  if (out.empty() || pushed_ == 0 || !filter_.ready()) return;
+  const std::size_t newest = pushed_ - 1;
+  const std::size_t deepest = std::min({out.size() - 1, lag_, newest});
+  Eigen::Vector3d s = filter_.state();
+  for (std::size_t j = 0; j <= deepest; ++j) {
+    if (j > 0) {
+      const RtsLink& link = links_[(newest - j) % kMaxLag];
+      s = link.C * s + link.d;
+    }
+    const Eigen::Vector3d u = filter_.unscale(s);
+    out[j].valid = true;
+    out[j].index = newest - j;
+    out[j].pos = u[0];
+    out[j].vel = u[1];
+    out[j].acc = u[2];
+  }
+}
+
 void FixedLag::reset() {
   filter_.reset();
   pushed_ = 0;
@@ -83,6 +105,15 @@ Estimate3 FixedLag3::push(const Eigen::Vector3d& x) {
 
 Estimate3 FixedLag3::estimate(std::size_t frames_back) const {
   return combine(axes_[0].estimate(frames_back), axes_[1].estimate(frames_back), axes_[2].estimate(frames_back));
+}
+
+void FixedLag3::estimate_window(std::span<Estimate3> out) const {
+  std::array<std::array<Estimate, FixedLag::kMaxLag + 1>, 3> axis{};
+  const std::size_t n = std::min(out.size(), FixedLag::kMaxLag + 1);
+  for (std::size_t c = 0; c < 3; ++c) axes_[c].estimate_window(std::span<Estimate>(axis[c].data(), n));
+  for (std::size_t j = 0; j < out.size(); ++j) {
+    out[j] = j < n ? combine(axis[0][j], axis[1][j], axis[2][j]) : Estimate3{};
+  }
 }
 
 void FixedLag3::reset() {

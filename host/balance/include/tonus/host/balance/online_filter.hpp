@@ -112,8 +112,9 @@ class OnlineBalance {
   // Rings over the window (lag + 1 frames), frame k at k % (lag + 1).
   std::vector<MotionFrame> frames_;
   std::vector<std::array<FootContact, 2>> frame_contacts_;
-  std::vector<SegmentFrame> placed_;     // the segments as captured
-  std::vector<ConvexPolygon> polygons_;  // the support polygon, from the contacts known when it arrived
+  std::vector<SegmentFrame> placed_;            // the segments as captured
+  std::vector<ConvexPolygon> polygons_;         // the support polygon, from the contacts known when it arrived
+  std::vector<derivatives::Estimate3> window_;  // per mass part, its smoother's window (frames back 0 .. lag)
   // Per window position (0 = the oldest): the ZMP error ahead, per axis.
   std::array<std::vector<double>, 2> errors_;
   std::vector<Vec2> zmp_;

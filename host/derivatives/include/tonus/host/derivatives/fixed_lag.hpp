@@ -22,6 +22,7 @@
 #include <array>
 #include <cstddef>
 #include <optional>
+#include <span>
 
 #include "tonus/host/derivatives/params.hpp"
 #include "tonus/host/derivatives/white_jerk.hpp"
@@ -56,6 +57,10 @@ class FixedLag {
   // lag - 1 .. 0 give the remaining samples, equal to the batch result.
   // Invalid if frames_back > lag or reaches before the first sample.
   [[nodiscard]] Estimate estimate(std::size_t frames_back) const;
+  // estimate(j) for j = 0 .. out.size() - 1 into out[j], in one backward pass
+  // (the same arithmetic, so the same bits, at the cost of one estimate of the
+  // deepest).
+  void estimate_window(std::span<Estimate> out) const;
 
   // Forgets every sample (keeps the parameters).
   void reset();
@@ -98,6 +103,8 @@ class FixedLag3 {
   static Created create(double dt_s, const Params& params, std::size_t lag);
   Estimate3 push(const Eigen::Vector3d& x);
   [[nodiscard]] Estimate3 estimate(std::size_t frames_back) const;
+  // As FixedLag::estimate_window, per coordinate.
+  void estimate_window(std::span<Estimate3> out) const;
   void reset();
   [[nodiscard]] const FixedLag& coordinate(std::size_t c) const { return axes_[c]; }
 
