@@ -46,34 +46,38 @@ TEST_CASE("tonus ik: walks from 3 and 6 trackers meet the goals") {
       CHECK(r.runs[2].mpjpe_cm < 3.0 * clean.mpjpe_cm + 10.0);
       // The input filter takes most of the noise's jitter out.
       CHECK(r.runs[3].jitter_ratio < 0.5 * r.runs[1].jitter_ratio);
-      // Jitter no higher than the clip's: met by the CMU walk from 3 points
-      // (0.81). Elsewhere not yet (docs/reference.md), so a ceiling just above
-      // today's figure keeps it from growing: 6 points 1.047 and 1.031
-      // (shoulders, chest, elbows, neck), the Bandai walk from 3 points 1.03
-      // (its 30 Hz swing feet).
+      // Jitter no higher than the clip's: met from 3 points (0.74 and 0.87
+      // since the procedural swings land at rest; 0.81 and 1.03 before), with
+      // a ceiling just above today's figures. 6 points not yet
+      // (docs/reference.md): 1.047 and 1.031 (shoulders, chest, elbows, neck).
       const bool cmu = clip.find("cmu_02_walk") != std::string::npos;
-      CHECK(clean.jitter_ratio <= (trackers == 6 ? 1.06 : (cmu ? 0.85 : 1.05)));
+      CHECK(clean.jitter_ratio <= (trackers == 6 ? 1.06 : (cmu ? 0.78 : 0.9)));
     }
   }
 }
 
-TEST_CASE("tonus ik: the run from 6 trackers is no jerkier than the clip") {
-  // The tracked feet's knees: their pole smoothed over 150 ms, not 50, as the
-  // foot's axis rolls with the swing ankle (1.029 before, 0.986 after).
+TEST_CASE("tonus ik: the run from 3 and 6 trackers is no jerkier than the clip") {
+  // 6 points: the tracked feet's knees, their pole smoothed over 150 ms, not
+  // 50, as the foot's axis rolls with the swing ankle (1.029 before, 0.986
+  // after). 3 points: the procedural swings land at rest where the pelvis
+  // will need them, with a softer stride (1.035 before, 0.979 after).
   const std::string run = std::string(TONUS_SHARED_DATA_DIR) + "/bvh/dataset-2_run_normal_010.bvh";
   if (!std::filesystem::exists(run)) {
     MESSAGE("no shared run clip: skipped");
     return;
   }
-  IkEvalOptions opt;
-  opt.clip = run;
-  opt.trackers = 6;
-  const IkEvalResult r = run_ik_eval(opt);
-  REQUIRE_MESSAGE(r.error.empty(), r.error);
-  const IkRun& clean = r.runs.at(0);
-  MESSAGE("run, 6 trackers: MPJPE " << clean.mpjpe_cm << " cm, jitter x" << clean.jitter_ratio);
-  CHECK(clean.mpjpe_cm <= 3.0);
-  CHECK(clean.jitter_ratio <= 1.0);
+  for (const int trackers : {3, 6}) {
+    CAPTURE(trackers);
+    IkEvalOptions opt;
+    opt.clip = run;
+    opt.trackers = trackers;
+    const IkEvalResult r = run_ik_eval(opt);
+    REQUIRE_MESSAGE(r.error.empty(), r.error);
+    const IkRun& clean = r.runs.at(0);
+    MESSAGE("run, " << trackers << " trackers: MPJPE " << clean.mpjpe_cm << " cm, jitter x" << clean.jitter_ratio);
+    CHECK(clean.mpjpe_cm <= (trackers == 3 ? 10.5 : 3.0));
+    CHECK(clean.jitter_ratio <= 1.0);
+  }
 }
 
 }  // namespace

@@ -289,6 +289,39 @@ TEST_CASE("tracker IK: walking forward, the feet step after the pelvis and stand
   }
 }
 
+TEST_CASE("tracker IK: a procedural swing comes down at rest, ahead of the walking pelvis") {
+  // A swing aimed at the moving place under the hip lands at the pelvis's
+  // speed and stops dead within a frame (the jerk the jitter measures); aimed
+  // at where that place will be, it lands at rest, still ahead of the hip.
+  IkRig rig = make_ik_rig(1.70, 3, {}, true);
+  Walker w{rig, {}, {}, {}};
+  const double dt = 1.0 / 90.0;
+  std::array<double, 2> was_phase{-1.0, -1.0};
+  std::array<Vec3, 2> last{Vec3::Zero(), Vec3::Zero()};
+  int landings = 0;
+  double fastest_landing = 0.0, least_lead = 1.0;
+  for (int k = 0; k * dt <= 4.0; ++k) {
+    const double t = k * dt;
+    w.at(t, Vec3(t * 1.0, 0.0, 0.901), 0.0);  // 1 m/s
+    const auto j = solved_joints(rig, w.out.qpos);
+    for (std::size_t s = 0; s < 2; ++s) {
+      const Vec3 ankle = j[sim::index(s == 0 ? Bone::LeftFoot : Bone::RightFoot)];
+      if (t > 1.0 && was_phase[s] >= 0.0 && w.state.foot[s].phase < 0.0) {
+        ++landings;
+        fastest_landing = std::max(fastest_landing, (ankle - last[s]).norm() / dt);
+        least_lead = std::min(least_lead, ankle.x() - w.out.qpos[0]);
+      }
+      was_phase[s] = w.state.foot[s].phase;
+      last[s] = ankle;
+    }
+  }
+  MESSAGE("landings " << landings << ", fastest ankle at touch-down " << fastest_landing << " m/s, least lead "
+                      << least_lead << " m");
+  CHECK(landings >= 6);
+  CHECK(fastest_landing < 0.25);  // the brake sampled at 90 Hz; aimed at the moving place: about 1 m/s
+  CHECK(least_lead > 0.05);
+}
+
 TEST_CASE("tracker IK: procedural legs reach softly while walking, exactly standing") {
   // The same stream solved with the soft stride and without it: the feet's
   // targets are the same (steps follow the pelvis, not the legs).

@@ -140,7 +140,7 @@ IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calib
   const IkOptions& o = options;
   const bool times_ok = o.step_time_s > 0.0 && o.step_time_min_s > 0.0 && o.step_time_min_s <= o.step_time_s &&
                         o.hold_s >= 0.0 && o.ease_s >= 0.0 && o.recover_s >= 0.0 && o.step_lead_s >= 0.0 &&
-                        o.velocity_time_constant_s >= 0.0 && o.trunk_smoothing_s >= 0.0 &&
+                        o.velocity_time_constant_s >= 0.0 && o.landing_follow_s >= 0.0 && o.trunk_smoothing_s >= 0.0 &&
                         o.heading_smoothing_s >= 0.0 && o.waist_heading_smoothing_s >= 0.0 &&
                         o.elbow_smoothing_s >= 0.0 && o.stride_soft_fade_s >= 0.0 && o.knee_smoothing_s >= 0.0 &&
                         o.tracked_knee_smoothing_s >= 0.0;

@@ -67,9 +67,9 @@ struct IkOptions {
   // that straightens the stance leg jerks the knee; soft, the heel rises a
   // little instead. Standing still it fades out (over stride_soft_fade_s), so
   // a standing leg is straight and its foot exactly on the floor.
-  double stride_softness_m = 0.03;
+  double stride_softness_m = 0.12;
   double stride_soft_speed_mps = 0.3;
-  double stride_soft_fade_s = 0.2;
+  double stride_soft_fade_s = 0.15;
   double elbow_smoothing_s = 0.05;  // time constant of the elbows' pole (0: none)
   double knee_smoothing_s = 0.05;   // ... and the knees'
   // ... and the knees' over a tracked foot, whose left axis names the knee's
@@ -86,6 +86,12 @@ struct IkOptions {
   // stands, and a stride in the wrong phase is a step length off: shorter
   // steps are the better guess (measured on real walks, docs/reference.md).
   double step_lead_s = 0.1;
+  // A swing lands where its place will be when it lands (the pelvis's
+  // velocity carried over the swing), so the foot comes down at rest rather
+  // than at the pelvis's speed. That point follows the prediction with this
+  // time constant, the following fading out toward touch-down; a pelvis that
+  // slows to under 0.4 of the step's starting speed pulls it in at once.
+  double landing_follow_s = 0.15;
   double velocity_time_constant_s = 0.1;  // smoothing of the pelvis's speed
   // Input smoothing: the 1-euro filter (Casiez et al. 2012) on every tracker
   // sample, for noisy trackers. Off by default: it adds lag (about
@@ -190,7 +196,10 @@ struct IkState {
     double yaw_rad = 0.0;
     sim::Vec3 from = sim::Vec3::Zero();
     double from_yaw_rad = 0.0;
-    double phase = -1.0;  // < 0: planted; [0, 1): stepping
+    sim::Vec3 land = sim::Vec3::Zero();  // where the swing comes down (IkOptions::landing_follow_s)
+    double land_yaw_rad = 0.0;           // the heading it turns to, followed without wrapping
+    double start_speed_mps = 0.0;        // the pelvis's speed when the swing started
+    double phase = -1.0;                 // < 0: planted; [0, 1): stepping
     double duration_s = 0.0;
   };
   std::array<Foot, 2> foot{};
