@@ -46,12 +46,14 @@ TEST_CASE("tonus ik: walks from 3 and 6 trackers meet the goals") {
       CHECK(r.runs[2].mpjpe_cm < 3.0 * clean.mpjpe_cm + 10.0);
       // The input filter takes most of the noise's jitter out.
       CHECK(r.runs[3].jitter_ratio < 0.5 * r.runs[1].jitter_ratio);
-      // Jitter no higher than the clip's: met from 3 points (0.74 and 0.87
-      // since the procedural swings land at rest; 0.81 and 1.03 before), with
-      // a ceiling just above today's figures. 6 points not yet
-      // (docs/reference.md): 1.047 and 1.031 (shoulders, chest, elbows, neck).
+      // Jitter no higher than the clip's, with a ceiling just above today's
+      // figures: 3 points 0.74 and 0.87 since the procedural swings land at
+      // rest (0.81 and 1.03 before); 6 points 0.97 and 0.97 since the neck
+      // joint keeps behind the spine-to-head line (1.047 and 1.031 before:
+      // it swung across the line with the head's sway, shaking the neck,
+      // shoulders and arms).
       const bool cmu = clip.find("cmu_02_walk") != std::string::npos;
-      CHECK(clean.jitter_ratio <= (trackers == 6 ? 1.06 : (cmu ? 0.78 : 0.9)));
+      CHECK(clean.jitter_ratio <= (trackers == 6 ? 0.99 : (cmu ? 0.78 : 0.9)));
     }
   }
 }

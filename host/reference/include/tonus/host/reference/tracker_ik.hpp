@@ -54,6 +54,11 @@ struct IkOptions {
   double trunk_follows_pelvis = 0.5;        // 6 points: the share of the waist tracker's turn (about the vertical) the
                                             // spine and chest take ...
   double trunk_tilts_with_pelvis = 0.25;    // ... and of its tilt and roll
+  // 6 points: the neck joint goes to the side of the spine-to-head line the
+  // guessed trunk names, pulled behind it by this (times the trunk's length):
+  // an upright trunk and neck are nearly in line and the guess alone let the
+  // neck joint swing across with the head's sway.
+  double neck_back_pole_weight = 0.1;
   // Arms.
   double clavicle_share = 0.08;        // of the swing that would point the clavicle at the hand
   double clavicle_raise_share = 0.25;  // added in proportion to how far above the shoulder the hand is
