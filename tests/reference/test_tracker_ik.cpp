@@ -322,6 +322,46 @@ TEST_CASE("tracker IK: a procedural swing comes down at rest, ahead of the walki
   CHECK(least_lead > 0.05);
 }
 
+TEST_CASE("tracker IK: a planted foot pivots under a body spinning faster than it steps") {
+  // Two turns in place in 1.5 s: one foot steps at a time, so the other
+  // stands while the body turns past it. It keeps its heading for the first
+  // foot_pivot_start_rad, then turns about its ankle, the pelvis's lead over
+  // it saturating toward start + width (before: the leg twisted up to the
+  // ankle's and hip's ranges, which then dragged the foot round).
+  IkRig rig = make_ik_rig(1.70, 3, {}, true);
+  Walker w{rig, {}, {}, {}};
+  const IkOptions& o = rig.ik->options;
+  const double dt = 1.0 / 90.0;
+  const auto yaw_of = [](const Vec3& d) { return std::atan2(d.y(), d.x()); };
+  const auto foot_yaw = [&](const std::array<Vec3, sim::kBoneCount>& j, std::size_t s) {
+    const std::size_t ankle = sim::index(s == 0 ? Bone::LeftFoot : Bone::RightFoot);
+    return yaw_of(j[ankle + 1] - j[ankle]);
+  };
+  const auto pelvis_yaw = [&](const std::array<Vec3, sim::kBoneCount>& j) {
+    const Vec3 left = j[sim::index(Bone::LeftUpperLeg)] - j[sim::index(Bone::RightUpperLeg)];
+    return yaw_of(Vec3(left.y(), -left.x(), 0.0));
+  };
+  w.at(0.0, Vec3(0.0, 0.0, 0.901), 0.0);
+  const auto j0 = solved_joints(rig, w.out.qpos);
+  // The feet's rest heading against the pelvis's.
+  const std::array<double, 2> splay{foot_yaw(j0, 0) - pelvis_yaw(j0), foot_yaw(j0, 1) - pelvis_yaw(j0)};
+  double widest = 0.0;
+  for (int k = 1; k * dt <= 1.5; ++k) {
+    w.at(k * dt, Vec3(0.0, 0.0, 0.901), 4.0 * std::numbers::pi * k * dt / 1.5);
+    const auto j = solved_joints(rig, w.out.qpos);
+    for (std::size_t s = 0; s < 2; ++s) {
+      if (w.state.foot[s].phase >= 0.0) continue;
+      const double lead = std::remainder(pelvis_yaw(j) - (foot_yaw(j, s) - splay[s]), 2.0 * std::numbers::pi);
+      widest = std::max(widest, std::abs(lead));
+    }
+  }
+  MESSAGE("the spinning pelvis's widest lead over a planted foot " << widest << " rad, " << w.state.stats.steps
+                                                                   << " steps");
+  CHECK(w.state.stats.steps >= 4);
+  CHECK(widest > o.foot_pivot_start_rad);
+  CHECK(widest < o.foot_pivot_start_rad + o.foot_pivot_width_rad + 0.02);
+}
+
 TEST_CASE("tracker IK: procedural legs reach softly while walking, exactly standing") {
   // The same stream solved with the soft stride and without it: the feet's
   // targets are the same (steps follow the pelvis, not the legs).

@@ -12,6 +12,18 @@ namespace {
 
 double wrap(double a) { return std::remainder(a, 2.0 * std::numbers::pi); }
 
+// A planted foot's heading as seen from the pelvis: the pelvis's turn from
+// the foot (`turn`, unwrapped) as it is up to `start`, then saturating
+// smoothly (an exponential, matched in value and slope) toward start + width.
+// A body that turns further pivots the foot about its ankle rather than
+// twisting the leg into the ankle's and hip's ranges (a spinning kick's
+// clamps dragged the standing foot round by fits).
+double pivot_kept(double turn, double start, double width) {
+  const double a = std::abs(turn);
+  if (width <= 0.0 || a <= start) return turn;
+  return std::copysign(start + width * (1.0 - std::exp(-(a - start) / width)), turn);
+}
+
 // A pelvis slowing under these shares of the speed its step started with is
 // stopping: the landing point goes to its prediction at once (smoothstep
 // between the two), so a stopped body stands on feet under its hips. The
@@ -44,6 +56,7 @@ void plant_feet(const IkModel& model, IkState& state, const sim::Vec3& pelvis, d
     IkState::Foot& f = state.foot[s];
     f.planted = ideal_ankle(model, pelvis, pelvis_yaw_rad, s);
     f.yaw_rad = pelvis_yaw_rad;
+    f.turn_rad = 0.0;
     f.phase = -1.0;
   }
 }
@@ -60,6 +73,11 @@ bool advance_feet(const IkModel& model, IkState& state, const sim::Vec3& pelvis,
   for (std::size_t s = 0; s < 2; ++s) under[s] = ideal_ankle(model, pelvis, pelvis_yaw_rad, s);
   const double reach_out = std::max(o.step_threshold_m, o.step_lead_s * speed);
 
+  const double pivot_start = o.foot_pivot_start_rad, pivot_width = o.foot_pivot_width_rad;
+  // The pelvis's turn from each planted foot, followed unwrapped.
+  for (IkState::Foot& f : state.foot) {
+    if (f.phase < 0.0) f.turn_rad += wrap(pelvis_yaw_rad - f.yaw_rad - f.turn_rad);
+  }
   bool started = false;
   bool any_stepping = false;
   for (std::size_t s = 0; s < 2; ++s) {
@@ -69,6 +87,7 @@ bool advance_feet(const IkModel& model, IkState& state, const sim::Vec3& pelvis,
     if (f.phase >= 1.0) {
       f.planted = f.land;
       f.yaw_rad = f.land_yaw_rad;
+      f.turn_rad = wrap(pelvis_yaw_rad - f.yaw_rad);
       f.phase = -1.0;
     } else {
       any_stepping = true;
@@ -83,7 +102,7 @@ bool advance_feet(const IkModel& model, IkState& state, const sim::Vec3& pelvis,
       const IkState::Foot& f = state.foot[s];
       if (tracked[s]) continue;
       const double off = (horizontal(f.planted - under[s])).norm() / reach_out;
-      const double turn = std::abs(wrap(f.yaw_rad - pelvis_yaw_rad)) / o.step_turn_rad;
+      const double turn = std::abs(f.turn_rad) / o.step_turn_rad;
       const double score = std::max(off, turn);
       if (score > worst) {
         worst = score;
@@ -93,7 +112,7 @@ bool advance_feet(const IkModel& model, IkState& state, const sim::Vec3& pelvis,
     if (pick >= 0) {
       IkState::Foot& f = state.foot[static_cast<std::size_t>(pick)];
       f.from = f.planted;
-      f.from_yaw_rad = f.yaw_rad;
+      f.from_yaw_rad = pelvis_yaw_rad - pivot_kept(f.turn_rad, pivot_start, pivot_width);
       f.phase = 0.0;
       const double fast = std::clamp(speed / 1.5, 0.0, 1.0);
       f.duration_s = o.step_time_s - fast * (o.step_time_s - o.step_time_min_s);
@@ -108,7 +127,7 @@ bool advance_feet(const IkModel& model, IkState& state, const sim::Vec3& pelvis,
   for (std::size_t s = 0; s < 2; ++s) {
     IkState::Foot& f = state.foot[s];
     if (f.phase < 0.0) {
-      out[s] = {f.planted, f.yaw_rad};
+      out[s] = {f.planted, pelvis_yaw_rad - pivot_kept(f.turn_rad, pivot_start, pivot_width)};
       continue;
     }
     // The landing point follows its prediction from the pelvis's velocity now

@@ -150,9 +150,9 @@ IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calib
                         o.heading_smoothing_s >= 0.0 && o.waist_heading_smoothing_s >= 0.0 &&
                         o.elbow_smoothing_s >= 0.0 && o.stride_soft_fade_s >= 0.0 && o.knee_smoothing_s >= 0.0 &&
                         o.tracked_knee_smoothing_s >= 0.0;
-  const bool sizes_ok = o.step_threshold_m > 0.0 && o.step_turn_rad > 0.0 && o.step_lift_m >= 0.0 &&
-                        o.implausible_reach_factor > 1.0 && o.leg_softness_m >= 0.0 && o.stride_softness_m >= 0.0 &&
-                        o.stride_soft_speed_mps > 0.0;
+  const bool sizes_ok = o.step_threshold_m > 0.0 && o.step_turn_rad > 0.0 && o.foot_pivot_start_rad >= 0.0 &&
+                        o.foot_pivot_width_rad >= 0.0 && o.step_lift_m >= 0.0 && o.implausible_reach_factor > 1.0 &&
+                        o.leg_softness_m >= 0.0 && o.stride_softness_m >= 0.0 && o.stride_soft_speed_mps > 0.0;
   const bool shares_ok = o.pelvis_share >= 0.0 && o.spine_share >= 0.0 && o.chest_share >= 0.0 && o.neck_share >= 0.0 &&
                          o.pelvis_share <= 1.0 && o.spine_share <= 1.0 && o.trunk_follows_pelvis >= 0.0 &&
                          o.trunk_follows_pelvis <= 1.0 && o.trunk_tilts_with_pelvis >= 0.0 &&

@@ -83,9 +83,15 @@ struct IkOptions {
   // Steps (3 points).
   double step_threshold_m = 0.12;  // a planted foot further than this from its place under the hip steps
   double step_turn_rad = 0.6;      // ... or turned further than this from the pelvis's heading
-  double step_time_s = 0.45;       // one step's swing at standing pace
-  double step_time_min_s = 0.38;   // when walking fast (a swing takes about 0.4 s at any pace)
-  double step_lift_m = 0.05;       // swing height (the arc is much of a swing's jerk)
+  // A planted foot keeps its heading while the pelvis turns up to this from
+  // it; further, it pivots about its ankle, the pelvis's turn from it
+  // saturating smoothly toward start + width (0: never pivots), so a body
+  // spinning faster than it steps does not twist the legs into their ranges.
+  double foot_pivot_start_rad = 0.3;
+  double foot_pivot_width_rad = 0.2;
+  double step_time_s = 0.45;      // one step's swing at standing pace
+  double step_time_min_s = 0.38;  // when walking fast (a swing takes about 0.4 s at any pace)
+  double step_lift_m = 0.05;      // swing height (the arc is much of a swing's jerk)
   // A foot lands this far ahead of the moving pelvis. Half a stance (about
   // 0.33 s) would make a walk's stride, but 3 points do not say which foot
   // stands, and a stride in the wrong phase is a step length off: shorter
@@ -198,7 +204,8 @@ struct IkState {
   double stride_soft_share = 0.0;  // [0, 1]: how much of stride_softness_m the procedural legs take now
   struct Foot {
     sim::Vec3 planted = sim::Vec3::Zero();  // ankle joint position
-    double yaw_rad = 0.0;
+    double yaw_rad = 0.0;                   // the heading it was planted with
+    double turn_rad = 0.0;                  // the pelvis's heading less that, followed unwrapped (planted)
     sim::Vec3 from = sim::Vec3::Zero();
     double from_yaw_rad = 0.0;
     sim::Vec3 land = sim::Vec3::Zero();  // where the swing comes down (IkOptions::landing_follow_s)
