@@ -3,9 +3,11 @@
 // retargeted onto a humanoid, the solution judged by sim's kinematics too.
 #include <doctest/doctest.h>
 
+#include <array>
 #include <filesystem>
 
 #include "experiments/ik_eval.hpp"
+#include "support/sanitized.hpp"
 
 namespace tonus::experiments {
 namespace {
@@ -46,34 +48,64 @@ TEST_CASE("tonus ik: walks from 3 and 6 trackers meet the goals") {
       CHECK(r.runs[2].mpjpe_cm < 3.0 * clean.mpjpe_cm + 10.0);
       // The input filter takes most of the noise's jitter out.
       CHECK(r.runs[3].jitter_ratio < 0.5 * r.runs[1].jitter_ratio);
-      // Jitter no higher than the clip's: met by the CMU walk from 3 points
-      // (0.81). Elsewhere not yet (docs/reference.md), so a ceiling just above
-      // today's figure keeps it from growing: 6 points 1.047 and 1.031
-      // (shoulders, chest, elbows, neck), the Bandai walk from 3 points 1.03
-      // (its 30 Hz swing feet).
+      // Jitter no higher than the clip's, with a ceiling just above today's
+      // figures: 3 points 0.74 and 0.87 since the procedural swings land at
+      // rest (0.81 and 1.03 before); 6 points 0.97 and 0.97 since the neck
+      // joint keeps behind the spine-to-head line (1.047 and 1.031 before:
+      // it swung across the line with the head's sway, shaking the neck,
+      // shoulders and arms).
       const bool cmu = clip.find("cmu_02_walk") != std::string::npos;
-      CHECK(clean.jitter_ratio <= (trackers == 6 ? 1.06 : (cmu ? 0.85 : 1.05)));
+      CHECK(clean.jitter_ratio <= (trackers == 6 ? 0.99 : (cmu ? 0.78 : 0.9)));
     }
   }
 }
 
-TEST_CASE("tonus ik: the run from 6 trackers is no jerkier than the clip") {
-  // The tracked feet's knees: their pole smoothed over 150 ms, not 50, as the
-  // foot's axis rolls with the swing ankle (1.029 before, 0.986 after).
-  const std::string run = std::string(TONUS_SHARED_DATA_DIR) + "/bvh/dataset-2_run_normal_010.bvh";
-  if (!std::filesystem::exists(run)) {
-    MESSAGE("no shared run clip: skipped");
-    return;
+TEST_CASE("tonus ik: no jerkier than the clip on every shared clip but the kicks" *
+          tonus::test::heavy_under_sanitizers()) {
+  // The goal, jitter no higher than the source's, on the shared
+  // clips from 3 and 6 trackers (docs/reference.md). Met on 12 runs of 14
+  // since the procedural swings land at rest where the pelvis will need them
+  // (3-point walks 0.81 and 1.03 before, run 1.035), a planted foot pivots
+  // under a spinning body (kicks 1.40 -> 1.16) and the 6-point neck joint
+  // keeps behind the spine-to-head line (walks 1.047 and 1.031 before). The
+  // kicks are not (3 points 1.16, 6 points 1.18: the elbows at the arms'
+  // ranges, docs/reference.md), so a ceiling just above keeps them from
+  // growing. The run's MPJPE too: its 6-point knees (pole smoothed over
+  // 150 ms) once made it the worst 6-point run.
+  struct Clip {
+    const char* file;
+    std::array<double, 2> ceiling;  // 3, 6 trackers
+  };
+  // (The walks: the test above.)
+  const std::array<Clip, 5> clips{{{"cmu_01_01_jumps.bvh", {1.0, 1.0}},
+                                   {"dataset-2_run_normal_010.bvh", {1.0, 1.0}},
+                                   {"dataset-1_kick_normal_001.bvh", {1.18, 1.2}},
+                                   {"dataset-1_punch_normal_001.bvh", {1.0, 1.0}},
+                                   {"dataset-2_wave-both-hands_normal_001.bvh", {1.0, 1.0}}}};
+  for (const Clip& c : clips) {
+    const std::string path = std::string(TONUS_SHARED_DATA_DIR) + "/bvh/" + c.file;
+    if (!std::filesystem::exists(path)) {
+      MESSAGE("no shared clip " << c.file << ": skipped");
+      continue;
+    }
+    for (const int trackers : {3, 6}) {
+      CAPTURE(c.file);
+      CAPTURE(trackers);
+      IkEvalOptions opt;
+      opt.clip = path;
+      opt.trackers = trackers;
+      const IkEvalResult r = run_ik_eval(opt);
+      REQUIRE_MESSAGE(r.error.empty(), r.error);
+      const IkRun& clean = r.runs.at(0);
+      MESSAGE(std::string(c.file) << ", " << trackers << " trackers: MPJPE " << clean.mpjpe_cm << " cm, jitter x"
+                                  << clean.jitter_ratio);
+      CHECK(clean.jitter_ratio <= c.ceiling[trackers == 3 ? 0 : 1]);
+      CHECK(clean.hand_error_max_reached_mm <= 1.0);
+      if (std::string(c.file).find("run") != std::string::npos) {
+        CHECK(clean.mpjpe_cm <= (trackers == 3 ? 10.5 : 3.0));
+      }
+    }
   }
-  IkEvalOptions opt;
-  opt.clip = run;
-  opt.trackers = 6;
-  const IkEvalResult r = run_ik_eval(opt);
-  REQUIRE_MESSAGE(r.error.empty(), r.error);
-  const IkRun& clean = r.runs.at(0);
-  MESSAGE("run, 6 trackers: MPJPE " << clean.mpjpe_cm << " cm, jitter x" << clean.jitter_ratio);
-  CHECK(clean.mpjpe_cm <= 3.0);
-  CHECK(clean.jitter_ratio <= 1.0);
 }
 
 }  // namespace

@@ -289,6 +289,79 @@ TEST_CASE("tracker IK: walking forward, the feet step after the pelvis and stand
   }
 }
 
+TEST_CASE("tracker IK: a procedural swing comes down at rest, ahead of the walking pelvis") {
+  // A swing aimed at the moving place under the hip lands at the pelvis's
+  // speed and stops dead within a frame (the jerk the jitter measures); aimed
+  // at where that place will be, it lands at rest, still ahead of the hip.
+  IkRig rig = make_ik_rig(1.70, 3, {}, true);
+  Walker w{rig, {}, {}, {}};
+  const double dt = 1.0 / 90.0;
+  std::array<double, 2> was_phase{-1.0, -1.0};
+  std::array<Vec3, 2> last{Vec3::Zero(), Vec3::Zero()};
+  int landings = 0;
+  double fastest_landing = 0.0, least_lead = 1.0;
+  for (int k = 0; k * dt <= 4.0; ++k) {
+    const double t = k * dt;
+    w.at(t, Vec3(t * 1.0, 0.0, 0.901), 0.0);  // 1 m/s
+    const auto j = solved_joints(rig, w.out.qpos);
+    for (std::size_t s = 0; s < 2; ++s) {
+      const Vec3 ankle = j[sim::index(s == 0 ? Bone::LeftFoot : Bone::RightFoot)];
+      if (t > 1.0 && was_phase[s] >= 0.0 && w.state.foot[s].phase < 0.0) {
+        ++landings;
+        fastest_landing = std::max(fastest_landing, (ankle - last[s]).norm() / dt);
+        least_lead = std::min(least_lead, ankle.x() - w.out.qpos[0]);
+      }
+      was_phase[s] = w.state.foot[s].phase;
+      last[s] = ankle;
+    }
+  }
+  MESSAGE("landings " << landings << ", fastest ankle at touch-down " << fastest_landing << " m/s, least lead "
+                      << least_lead << " m");
+  CHECK(landings >= 6);
+  CHECK(fastest_landing < 0.25);  // the brake sampled at 90 Hz; aimed at the moving place: about 1 m/s
+  CHECK(least_lead > 0.05);
+}
+
+TEST_CASE("tracker IK: a planted foot pivots under a body spinning faster than it steps") {
+  // Two turns in place in 1.5 s: one foot steps at a time, so the other
+  // stands while the body turns past it. It keeps its heading for the first
+  // foot_pivot_start_rad, then turns about its ankle, the pelvis's lead over
+  // it saturating toward start + width (before: the leg twisted up to the
+  // ankle's and hip's ranges, which then dragged the foot round).
+  IkRig rig = make_ik_rig(1.70, 3, {}, true);
+  Walker w{rig, {}, {}, {}};
+  const IkOptions& o = rig.ik->options;
+  const double dt = 1.0 / 90.0;
+  const auto yaw_of = [](const Vec3& d) { return std::atan2(d.y(), d.x()); };
+  const auto foot_yaw = [&](const std::array<Vec3, sim::kBoneCount>& j, std::size_t s) {
+    const std::size_t ankle = sim::index(s == 0 ? Bone::LeftFoot : Bone::RightFoot);
+    return yaw_of(j[ankle + 1] - j[ankle]);
+  };
+  const auto pelvis_yaw = [&](const std::array<Vec3, sim::kBoneCount>& j) {
+    const Vec3 left = j[sim::index(Bone::LeftUpperLeg)] - j[sim::index(Bone::RightUpperLeg)];
+    return yaw_of(Vec3(left.y(), -left.x(), 0.0));
+  };
+  w.at(0.0, Vec3(0.0, 0.0, 0.901), 0.0);
+  const auto j0 = solved_joints(rig, w.out.qpos);
+  // The feet's rest heading against the pelvis's.
+  const std::array<double, 2> splay{foot_yaw(j0, 0) - pelvis_yaw(j0), foot_yaw(j0, 1) - pelvis_yaw(j0)};
+  double widest = 0.0;
+  for (int k = 1; k * dt <= 1.5; ++k) {
+    w.at(k * dt, Vec3(0.0, 0.0, 0.901), 4.0 * std::numbers::pi * k * dt / 1.5);
+    const auto j = solved_joints(rig, w.out.qpos);
+    for (std::size_t s = 0; s < 2; ++s) {
+      if (w.state.foot[s].phase >= 0.0) continue;
+      const double lead = std::remainder(pelvis_yaw(j) - (foot_yaw(j, s) - splay[s]), 2.0 * std::numbers::pi);
+      widest = std::max(widest, std::abs(lead));
+    }
+  }
+  MESSAGE("the spinning pelvis's widest lead over a planted foot " << widest << " rad, " << w.state.stats.steps
+                                                                   << " steps");
+  CHECK(w.state.stats.steps >= 4);
+  CHECK(widest > o.foot_pivot_start_rad);
+  CHECK(widest < o.foot_pivot_start_rad + o.foot_pivot_width_rad + 0.02);
+}
+
 TEST_CASE("tracker IK: procedural legs reach softly while walking, exactly standing") {
   // The same stream solved with the soft stride and without it: the feet's
   // targets are the same (steps follow the pelvis, not the legs).

@@ -1,6 +1,7 @@
 // Procedural stepping for 3-point tracking: each foot stays planted until the
 // pelvis has carried its ideal place too far away (or turned too far), then
-// steps there, one foot at a time, landing ahead of a moving pelvis.
+// steps there, one foot at a time, landing at rest where a moving pelvis will
+// need it.
 #pragma once
 
 #include "tonus/host/reference/tracker_ik.hpp"

@@ -102,10 +102,12 @@ Vec3 joint_of(const Work& w, const IkModel& m, Bone b) {
 // Where the neck joint goes so the neck reaches the head joint, the spine
 // and chest turned as one piece about the spine joint `base`: the middle
 // joint of the two links trunk (base to the guessed neck joint) and neck,
-// on the side of the guess. Closed form, so a smooth function of its inputs,
-// and the neck takes the head's quick moves as a real neck does. False (the
-// trunk pointed straight at the head) when the head is out of reach.
-bool reach_head(const Vec3& base, const Vec3& neck_guess, double neck_m, const Vec3& head, Vec3& neck_joint) {
+// on the side of the guess pulled toward `back` (unit). Closed form, so a
+// smooth function of its inputs, and the neck takes the head's quick moves as
+// a real neck does. False (the trunk pointed straight at the head) when the
+// head is out of reach.
+bool reach_head(const Vec3& base, const Vec3& neck_guess, double neck_m, const Vec3& head, const Vec3& back,
+                double back_weight, Vec3& neck_joint) {
   const Vec3 to_head = head - base;
   const double dist = to_head.norm();
   const double trunk_m = (neck_guess - base).norm();
@@ -115,8 +117,12 @@ bool reach_head(const Vec3& base, const Vec3& neck_guess, double neck_m, const V
   }
   const Vec3 u = to_head / dist;
   const double shortest = std::abs(trunk_m - neck_m), longest = trunk_m + neck_m;
+  // An upright trunk and neck are nearly in line (a few mm short of their
+  // length), so the guess alone names the side weakly and the neck joint
+  // swung across the line with the head's sway; the neck joint is behind the
+  // line from the spine to the head (the head sits forward on the neck).
   neck_joint = detail::place_middle_joint(base, u, std::clamp(dist, shortest, longest), trunk_m, neck_m,
-                                          neck_guess - base, u.unitOrthogonal())
+                                          neck_guess - base + back_weight * trunk_m * back, u.unitOrthogonal())
                    .pos;
   return dist <= longest && dist >= shortest;
 }
@@ -140,19 +146,19 @@ IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calib
   const IkOptions& o = options;
   const bool times_ok = o.step_time_s > 0.0 && o.step_time_min_s > 0.0 && o.step_time_min_s <= o.step_time_s &&
                         o.hold_s >= 0.0 && o.ease_s >= 0.0 && o.recover_s >= 0.0 && o.step_lead_s >= 0.0 &&
-                        o.velocity_time_constant_s >= 0.0 && o.trunk_smoothing_s >= 0.0 &&
+                        o.velocity_time_constant_s >= 0.0 && o.landing_follow_s >= 0.0 && o.trunk_smoothing_s >= 0.0 &&
                         o.heading_smoothing_s >= 0.0 && o.waist_heading_smoothing_s >= 0.0 &&
                         o.elbow_smoothing_s >= 0.0 && o.stride_soft_fade_s >= 0.0 && o.knee_smoothing_s >= 0.0 &&
                         o.tracked_knee_smoothing_s >= 0.0;
-  const bool sizes_ok = o.step_threshold_m > 0.0 && o.step_turn_rad > 0.0 && o.step_lift_m >= 0.0 &&
-                        o.implausible_reach_factor > 1.0 && o.leg_softness_m >= 0.0 && o.stride_softness_m >= 0.0 &&
-                        o.stride_soft_speed_mps > 0.0;
+  const bool sizes_ok = o.step_threshold_m > 0.0 && o.step_turn_rad > 0.0 && o.foot_pivot_start_rad >= 0.0 &&
+                        o.foot_pivot_width_rad >= 0.0 && o.step_lift_m >= 0.0 && o.implausible_reach_factor > 1.0 &&
+                        o.leg_softness_m >= 0.0 && o.stride_softness_m >= 0.0 && o.stride_soft_speed_mps > 0.0;
   const bool shares_ok = o.pelvis_share >= 0.0 && o.spine_share >= 0.0 && o.chest_share >= 0.0 && o.neck_share >= 0.0 &&
                          o.pelvis_share <= 1.0 && o.spine_share <= 1.0 && o.trunk_follows_pelvis >= 0.0 &&
                          o.trunk_follows_pelvis <= 1.0 && o.trunk_tilts_with_pelvis >= 0.0 &&
                          o.trunk_tilts_with_pelvis <= 1.0 && o.chest_share <= 1.0 && o.neck_share <= 1.0 &&
-                         o.hands_heading_weight >= 0.0 && o.clavicle_share >= 0.0 && o.clavicle_raise_share >= 0.0 &&
-                         o.default_pole_weight >= 0.0 && o.elbow_stay_weight >= 0.0;
+                         o.hands_heading_weight >= 0.0 && o.neck_back_pole_weight >= 0.0 && o.clavicle_share >= 0.0 &&
+                         o.clavicle_raise_share >= 0.0 && o.default_pole_weight >= 0.0 && o.elbow_stay_weight >= 0.0;
   if (!(times_ok && sizes_ok && shares_ok)) {
     c.error = "tracker IK: an option is out of range (times and lengths must be positive, shares in [0, 1])";
     return c;
@@ -314,7 +320,8 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     const Vec3 base = hips.pos_m + hips.rot * m.offset[bi(Bone::Spine)];
     const Vec3 guess = base + spine * m.offset[bi(Bone::Chest)] + chest * m.offset[bi(Bone::Neck)];
     Vec3 neck_joint;
-    const bool reachable = reach_head(base, guess, m.offset[bi(Bone::Head)].norm(), head.pos_m, neck_joint);
+    const bool reachable = reach_head(base, guess, m.offset[bi(Bone::Head)].norm(), head.pos_m, chest * -Vec3::UnitX(),
+                                      o.neck_back_pole_weight, neck_joint);
     const Quat turn = sim::quat_from_two_vectors(guess - base, neck_joint - base);
     settle_ball(m, w, Bone::Spine, (turn * spine).normalized());
     settle_ball(m, w, Bone::Chest, (turn * chest).normalized());

@@ -54,6 +54,11 @@ struct IkOptions {
   double trunk_follows_pelvis = 0.5;        // 6 points: the share of the waist tracker's turn (about the vertical) the
                                             // spine and chest take ...
   double trunk_tilts_with_pelvis = 0.25;    // ... and of its tilt and roll
+  // 6 points: the neck joint goes to the side of the spine-to-head line the
+  // guessed trunk names, pulled behind it by this (times the trunk's length):
+  // an upright trunk and neck are nearly in line and the guess alone let the
+  // neck joint swing across with the head's sway.
+  double neck_back_pole_weight = 0.1;
   // Arms.
   double clavicle_share = 0.08;        // of the swing that would point the clavicle at the hand
   double clavicle_raise_share = 0.25;  // added in proportion to how far above the shoulder the hand is
@@ -67,9 +72,9 @@ struct IkOptions {
   // that straightens the stance leg jerks the knee; soft, the heel rises a
   // little instead. Standing still it fades out (over stride_soft_fade_s), so
   // a standing leg is straight and its foot exactly on the floor.
-  double stride_softness_m = 0.03;
+  double stride_softness_m = 0.12;
   double stride_soft_speed_mps = 0.3;
-  double stride_soft_fade_s = 0.2;
+  double stride_soft_fade_s = 0.15;
   double elbow_smoothing_s = 0.05;  // time constant of the elbows' pole (0: none)
   double knee_smoothing_s = 0.05;   // ... and the knees'
   // ... and the knees' over a tracked foot, whose left axis names the knee's
@@ -78,14 +83,26 @@ struct IkOptions {
   // Steps (3 points).
   double step_threshold_m = 0.12;  // a planted foot further than this from its place under the hip steps
   double step_turn_rad = 0.6;      // ... or turned further than this from the pelvis's heading
-  double step_time_s = 0.45;       // one step's swing at standing pace
-  double step_time_min_s = 0.38;   // when walking fast (a swing takes about 0.4 s at any pace)
-  double step_lift_m = 0.05;       // swing height (the arc is much of a swing's jerk)
+  // A planted foot keeps its heading while the pelvis turns up to this from
+  // it; further, it pivots about its ankle, the pelvis's turn from it
+  // saturating smoothly toward start + width (0: never pivots), so a body
+  // spinning faster than it steps does not twist the legs into their ranges.
+  double foot_pivot_start_rad = 0.3;
+  double foot_pivot_width_rad = 0.2;
+  double step_time_s = 0.45;      // one step's swing at standing pace
+  double step_time_min_s = 0.38;  // when walking fast (a swing takes about 0.4 s at any pace)
+  double step_lift_m = 0.05;      // swing height (the arc is much of a swing's jerk)
   // A foot lands this far ahead of the moving pelvis. Half a stance (about
   // 0.33 s) would make a walk's stride, but 3 points do not say which foot
   // stands, and a stride in the wrong phase is a step length off: shorter
   // steps are the better guess (measured on real walks, docs/reference.md).
   double step_lead_s = 0.1;
+  // A swing lands where its place will be when it lands (the pelvis's
+  // velocity carried over the swing), so the foot comes down at rest rather
+  // than at the pelvis's speed. That point follows the prediction with this
+  // time constant, the following fading out toward touch-down; a pelvis that
+  // slows to under 0.4 of the step's starting speed pulls it in at once.
+  double landing_follow_s = 0.15;
   double velocity_time_constant_s = 0.1;  // smoothing of the pelvis's speed
   // Input smoothing: the 1-euro filter (Casiez et al. 2012) on every tracker
   // sample, for noisy trackers. Off by default: it adds lag (about
@@ -187,10 +204,14 @@ struct IkState {
   double stride_soft_share = 0.0;  // [0, 1]: how much of stride_softness_m the procedural legs take now
   struct Foot {
     sim::Vec3 planted = sim::Vec3::Zero();  // ankle joint position
-    double yaw_rad = 0.0;
+    double yaw_rad = 0.0;                   // the heading it was planted with
+    double turn_rad = 0.0;                  // the pelvis's heading less that, followed unwrapped (planted)
     sim::Vec3 from = sim::Vec3::Zero();
     double from_yaw_rad = 0.0;
-    double phase = -1.0;  // < 0: planted; [0, 1): stepping
+    sim::Vec3 land = sim::Vec3::Zero();  // where the swing comes down (IkOptions::landing_follow_s)
+    double land_yaw_rad = 0.0;           // the heading it turns to, followed without wrapping
+    double start_speed_mps = 0.0;        // the pelvis's speed when the swing started
+    double phase = -1.0;                 // < 0: planted; [0, 1): stepping
     double duration_s = 0.0;
   };
   std::array<Foot, 2> foot{};
