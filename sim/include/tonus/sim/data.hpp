@@ -227,8 +227,9 @@ struct Data {
   std::array<double, kMaxDofs> solve_w{};
   std::array<Vec3, kMaxObjects> obj_dlin{};
   std::array<Vec3, kMaxObjects> obj_dang{};
-  std::array<double, kMaxRows> solve_before{};                          // impulses before the sweep
-  std::array<double, kMaxRows> solve_dir{};                             // the conjugate direction (see solver.cpp)
+  std::array<double, kMaxRows> solve_before{};      // impulses before the sweep
+  std::array<double, kMaxRows> solve_dir{};         // the conjugate direction (see solver.cpp)
+  std::array<double, kMaxRows> solve_checkpoint{};  // impulses before a subspace step on trial (solver.cpp)
   std::array<double, kSubspaceRows * kSubspaceRows> subspace_matrix{};  // the subspace step (solver.cpp)
   std::array<double, kSubspaceRows> subspace_rhs{};
   std::array<int, kSubspaceRows> subspace_rows{};
