@@ -438,6 +438,7 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     detail::TwoBoneLimb limb{m.rest_dir[bi(upper)], m.rest_dir[bi(fore)], m.hinge_axis[bi(fore)],
                              m.upper_arm_m[s],      m.forearm_m[s],       o.arm_softness_m};
     detail::TwoBoneSolution sol = detail::solve_two_bone(limb, shoulder, target.pos_m, pole, anatomic);
+    const Vec3 pole_free = pole;  // before the ranges turn it
     // An elbow the upper arm cannot twist to is turned about the shoulder-wrist
     // line until it can (the twist follows that turn almost one to one).
     const sim::JointLimit& lim = m.limit[bi(upper)];
@@ -478,6 +479,14 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
         pole = Eigen::AngleAxisd(inside, axis) * pole;
         sol = detail::solve_two_bone(limb, shoulder, target.pos_m, pole, anatomic);
       }
+    }
+    // The smoothed cue remembers the turn the ranges forced (about the line),
+    // so the next frame starts from the side they allow rather than crossing
+    // back and being turned again (a flailing kick's arm at its twist range).
+    const Vec3 free_across = across_line(pole_free), used_across = across_line(pole);
+    if (free_across.norm() > 1e-9 && used_across.norm() > 1e-9) {
+      const Quat turned = sim::quat_from_two_vectors(free_across.normalized(), used_across.normalized());
+      st.elbow_pole[s] = (chest.conjugate() * (turned * (chest * st.elbow_pole[s]))).normalized();
     }
     st.elbow_last[s] = chest.conjugate() * (sol.upper * m.rest_dir[bi(upper)]);
     w.f.pos[bi(upper)] = shoulder;
