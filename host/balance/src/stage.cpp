@@ -1,7 +1,9 @@
 #include "tonus/host/balance/stage.hpp"
 
 #include <exception>
+#include <vector>
 
+#include "tonus/host/balance/family.hpp"
 #include "tonus/host/balance/filter.hpp"
 
 namespace tonus::balance {
@@ -15,30 +17,13 @@ std::string_view to_string(BalanceMode mode) {
   return "?";
 }
 
-bool parse_balance_mode(std::string_view text, BalanceMode& mode) {
-  for (const BalanceMode m : {BalanceMode::off, BalanceMode::offline, BalanceMode::online}) {
-    if (text == to_string(m)) {
-      mode = m;
-      return true;
-    }
-  }
-  return false;
-}
-
-namespace {
-
-std::size_t supported(const Analysis& a) {
-  return a.summary.frames - a.summary.frames_airborne - a.summary.frames_undefined;
-}
-
-}  // namespace
-
 BalanceStageResult balance_stage(const HumanMotion& motion, const BalanceStageOptions& options) {
   BalanceStageResult r;
   r.motion = motion;
   if (options.mode == BalanceMode::off) return r;
   try {
     const AnalysisOptions& analysis = options.analysis;
+    Analysis before, after;
     if (options.mode == BalanceMode::offline) {
       FilterOptions fo;
       fo.analysis = analysis;
@@ -48,6 +33,8 @@ BalanceStageResult balance_stage(const HumanMotion& motion, const BalanceStageOp
         return r;
       }
       r.motion = std::move(f.corrected);
+      before = std::move(f.before);  // the filter analysed both already
+      after = std::move(f.after);
     } else {
       OnlineOptions oo;
       oo.analysis = analysis;
@@ -60,19 +47,21 @@ BalanceStageResult balance_stage(const HumanMotion& motion, const BalanceStageOp
       }
       r.motion = std::move(run.corrected);
       r.lookahead_frames = run.lookahead_frames;
+      before = analyse(motion, analysis);
+      if (!before.ok()) {
+        r.error = "balance analysis: " + before.error;
+        r.motion = motion;
+        return r;
+      }
+      after = analyse(r.motion, analysis, &before.contacts);
     }
-    AnalysisOptions counting = analysis;
-    counting.tolerance_m = 0.01;
-    const Analysis before = analyse(motion, counting);
-    if (!before.ok()) {
-      r.error = "balance analysis: " + before.error;
-      r.motion = motion;
-      return r;
-    }
-    const Analysis after = analyse(r.motion, counting, &before.contacts);
-    r.frames_outside_before = before.summary.frames_outside;
-    r.frames_outside_after = after.summary.frames_outside;
-    r.supported_frames = supported(before);
+    // Counted as the estimator family counts: frames with a foot down and the
+    // ZMP defined, outside by more than kFamilyThreshold_m (1 cm).
+    const std::vector<AnalysisOptions> one{analysis};
+    const MemberVerdict b = family_verdict({before}, one).members.front();
+    r.frames_outside_before = b.outside;
+    r.frames_outside_after = family_verdict({after}, one).members.front().outside;
+    r.supported_frames = b.supported;
   } catch (const std::exception& e) {  // an allocation failure on an absurd clip: refuse, keep the input
     r = BalanceStageResult{};
     r.motion = motion;

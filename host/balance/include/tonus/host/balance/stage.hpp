@@ -17,9 +17,8 @@ namespace tonus::balance {
 
 enum class BalanceMode : std::uint8_t { off, offline, online };
 
+// "off", "offline", "online": the words tonusd's config reads.
 std::string_view to_string(BalanceMode mode);
-// "off", "offline" or "online"; false (mode untouched) for anything else.
-bool parse_balance_mode(std::string_view text, BalanceMode& mode);
 
 struct BalanceStageOptions {
   BalanceMode mode = BalanceMode::off;
@@ -30,8 +29,8 @@ struct BalanceStageOptions {
 struct BalanceStageResult {
   HumanMotion motion;  // corrected (off: the input)
   // Supported frames with the ZMP outside the support polygon by more than
-  // 1 cm, under the analysis options' estimator, before and after (off: not
-  // analysed, both zero).
+  // 1 cm, under the analysis options' estimator, before and after, counted as
+  // family_verdict counts (off: not analysed, all zero).
   std::size_t frames_outside_before = 0;
   std::size_t frames_outside_after = 0;
   std::size_t supported_frames = 0;
