@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "balance_fixtures.hpp"
-#include "independent/zmp_estimator.hpp"
+#include "independent_counts.hpp"
 #include "support/sanitized.hpp"
 #include "tonus/host/balance/apply.hpp"
 #include "tonus/host/balance/mass_model.hpp"
@@ -60,20 +60,15 @@ Crosschecked crosscheck(const std::string& name, const std::string& path, double
   const motion::ReadResult back = motion::parse_bvh(motion::write_bvh(applied.clip, 6));
   REQUIRE(back.ok());
 
-  indep::Options io;
-  io.metres_per_unit = unit_m;
-  io.first_frame = first_frame;
-  const indep::Estimate before = indep::estimate_zmp(l.clip, io), after = indep::estimate_zmp(back.clip, io);
-  REQUIRE(before.ok());
-  REQUIRE(after.ok());
+  const test::IndependentCounts independent = test::independent_counts(l.clip, back.clip, unit_m, first_frame);
 
   const RobustFilterResult offline = robust_balance_filter(m, RobustFilterOptions{});
   REQUIRE_MESSAGE(offline.ok(), offline.error);
   const MassModel mass = make_mass_model(oo.analysis.body_mass_kg, oo.analysis.sex);
   Crosschecked c;
-  c.independent_before = before.summary.outside;
-  c.independent_after = after.summary.outside;
-  c.independent_supported = after.summary.supported;
+  c.independent_before = independent.before;
+  c.independent_after = independent.after;
+  c.independent_supported = independent.supported;
   c.online_to_offline = com_distance(online.corrected, offline.corrected, mass);
   c.offline_edit = com_distance(m, offline.corrected, mass);
   c.online_edit = com_distance(m, online.corrected, mass);

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "balance_fixtures.hpp"
-#include "independent/zmp_estimator.hpp"
+#include "independent_counts.hpp"
 #include "support/sanitized.hpp"
 #include "tonus/host/balance/apply.hpp"
 #include "tonus/host/balance/robust_filter.hpp"
@@ -89,15 +89,10 @@ Checked run(const std::string& name, const std::string& path, double unit_m, std
                                       << " far, comfortable frames turned by more "
                                       << "than 1 degree (largest " << far_max / kDegree << ")");
 
-  indep::Options io;
-  io.metres_per_unit = unit_m;
-  io.first_frame = first_frame;
-  const indep::Estimate before = indep::estimate_zmp(l.clip, io), after = indep::estimate_zmp(back.clip, io);
-  REQUIRE(before.ok());
-  REQUIRE(after.ok());
-  c.independent_before = before.summary.outside;
-  c.independent_after = after.summary.outside;
-  c.independent_supported = after.summary.supported;
+  const test::IndependentCounts independent = test::independent_counts(l.clip, back.clip, unit_m, first_frame);
+  c.independent_before = independent.before;
+  c.independent_after = independent.after;
+  c.independent_supported = independent.supported;
 
   std::string members;
   for (std::size_t i = 0; i < c.written.members.size(); ++i) {
