@@ -199,15 +199,16 @@ void save_impulses(Data& data, int begin, int end) {
   }
 }
 
-// Back to the impulses save_impulses() kept.
-void restore_impulses(Data& data, int begin, int end) {
+// Back to impulses kept earlier: save_impulses()'s (solve_before) or a
+// subspace step's checkpoint (solve_checkpoint).
+void restore_impulses(Data& data, int begin, int end, const std::array<double, kMaxRows>& saved) {
   for (int p = begin; p < end; ++p) {
     const auto r = static_cast<size_t>(data.island_rows[static_cast<size_t>(p)]);
     Row& row = data.rows[r];
-    const double back = data.solve_before[r] - row.lambda;
+    const double back = saved[r] - row.lambda;
     if (back == 0.0) continue;
     apply_row_impulse(data, row, back);
-    row.lambda = data.solve_before[r];
+    row.lambda = saved[r];
   }
 }
 
@@ -515,20 +516,8 @@ SubspaceOutcome subspace_step(Data& data, int begin, int end, double before, dou
     }
     return SubspaceOutcome::on_trial;
   }
-  restore_impulses(data, begin, end);
+  restore_impulses(data, begin, end, data.solve_before);
   return SubspaceOutcome::rejected;
-}
-
-// Back to the impulses before a step on trial.
-void restore_checkpoint(Data& data, int begin, int end) {
-  for (int p = begin; p < end; ++p) {
-    const auto r = static_cast<size_t>(data.island_rows[static_cast<size_t>(p)]);
-    Row& row = data.rows[r];
-    const double back = data.solve_checkpoint[r] - row.lambda;
-    if (back == 0.0) continue;
-    apply_row_impulse(data, row, back);
-    row.lambda = data.solve_checkpoint[r];
-  }
 }
 
 // Sweeps before the first subspace step and between later ones. Most islands
@@ -580,7 +569,7 @@ void solve_rows(const Model& model, Data& data) {
       if (on_trial && subspace_point) {
         on_trial = false;
         if (!(residual < trial_residual)) {  // the step on trial did not pay: back to before it
-          restore_checkpoint(data, begin, end);
+          restore_impulses(data, begin, end, data.solve_checkpoint);
           residual = trial_residual;
           have_dir = false;
           ++subspace_misses;
@@ -610,7 +599,7 @@ void solve_rows(const Model& model, Data& data) {
     if (!done) {
       residual = pass(data, begin, end, false, updates);
       if (on_trial && !(residual < trial_residual)) {  // out of sweeps with a step on trial that did not pay
-        restore_checkpoint(data, begin, end);
+        restore_impulses(data, begin, end, data.solve_checkpoint);
         residual = trial_residual;
       }
       unconverged = unconverged || residual > opt.tolerance;
