@@ -5,6 +5,7 @@
 
 #include "rig.hpp"
 #include "rotations.hpp"
+#include "smoothstep.hpp"
 #include "tonus/sim/joint_limits.hpp"
 
 namespace tonus::reference {
@@ -363,8 +364,8 @@ BodyStatus BodyRetarget::solve(const BodySample& in, BodyRetargetState& st, std:
       const double bend = std::atan2(n.norm(), u.dot(f));
       const bool against = plane.dot(ref) < 0.0;
       if (!(against && bend < kOverstretch_rad)) {
-        double w = against ? 1.0 : std::clamp((bend - kStraight0_rad) / (kStraight1_rad - kStraight0_rad), 0.0, 1.0);
-        w = w * w * (3.0 - 2.0 * w);
+        const double w =
+            against ? 1.0 : detail::smoothstep((bend - kStraight0_rad) / (kStraight1_rad - kStraight0_rad));
         axis = w * plane + (1.0 - w) * ref;
       }
     }

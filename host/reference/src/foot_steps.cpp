@@ -6,6 +6,7 @@
 
 #include "body_frames.hpp"
 #include "first_order.hpp"
+#include "smoothstep.hpp"
 
 namespace tonus::reference::detail {
 namespace {
@@ -137,8 +138,7 @@ bool advance_feet(const IkModel& model, IkState& state, const sim::Vec3& pelvis,
     const sim::Vec3 predicted = under[s] + (left_s + o.step_lead_s) * v;
     f.land += first_order_share(dt_s, o.landing_follow_s) * (1.0 - f.phase) * (predicted - f.land);
     const double slowed = speed / std::max(f.start_speed_mps, kStopSpeedFloor_mps);
-    const double stop = std::clamp((kStopShareStart - slowed) / (kStopShareStart - kStopShareFull), 0.0, 1.0);
-    f.land += stop * stop * (3.0 - 2.0 * stop) * (predicted - f.land);
+    f.land += smoothstep((kStopShareStart - slowed) / (kStopShareStart - kStopShareFull)) * (predicted - f.land);
     // The heading too, unwrapped as it goes: a body spinning past half a turn
     // from the foot must not flip the foot's turn to the other way round.
     f.land_yaw_rad += wrap(pelvis_yaw_rad - f.land_yaw_rad);

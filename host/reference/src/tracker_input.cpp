@@ -3,15 +3,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "smoothstep.hpp"
+
 namespace tonus::reference::detail {
 namespace {
 
 constexpr double kFarthest_m = 1e3;  // a tracking space is never this large
-
-double smoothstep(double x) {
-  x = std::clamp(x, 0.0, 1.0);
-  return x * x * (3.0 - 2.0 * x);
-}
 
 }  // namespace
 
