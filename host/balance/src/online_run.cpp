@@ -33,7 +33,6 @@ OnlineRun run_online(const HumanMotion& motion, const OnlineOptions& options) {
   }
   while (filter.flush(out)) take();
   run.mean_push_us = motion.size() > 0 ? total_us / static_cast<double>(motion.size()) : 0.0;
-  run.non_finite_frames = filter.non_finite_frames();
   return run;
 }
 

@@ -141,7 +141,6 @@ struct OnlineRun {
   std::vector<Vec2> shift_m;  // per frame
   double max_drop_m = 0.0;
   std::size_t lookahead_frames = 0;
-  std::size_t non_finite_frames = 0;
   double mean_push_us = 0.0, max_push_us = 0.0;  // the cost of push(), wall clock
   std::string error;                             // the options were refused; nothing ran
   [[nodiscard]] bool ok() const { return error.empty(); }
