@@ -56,3 +56,36 @@ TEST_CASE("pacing: a long stall is skipped, a short one caught up, the schedule 
   CHECK(scheduled <= elapsed_ms + 2.0);
   CHECK(scheduled >= 0.95 * elapsed_ms - 30.0);
 }
+
+namespace {
+
+// Every tick costs one and a half periods: the thread falls further behind on
+// each, which is what a starved thread on a loaded machine sees.
+class SlowTarget final : public TickTarget {
+ public:
+  void tick(std::int64_t /*now_us*/) override {
+    ticks.fetch_add(1);
+    std::this_thread::sleep_for(std::chrono::microseconds(1500));
+  }
+  std::atomic<std::uint64_t> ticks{0};
+};
+
+}  // namespace
+
+TEST_CASE("pacing: a thread kept behind on every tick never runs more than max_catch_up_ticks late ticks in a row") {
+  SlowTarget target;
+  PacingConfig c;
+  c.rate_hz = 1000.0;
+  c.max_catch_up_ticks = 3;
+  c.realtime_priority = 0;
+  c.lock_memory = false;
+  PhysicsThread t(target, c);
+  t.start();
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  t.stop();
+  MESSAGE(t.ticks() << " ticks, " << t.skipped() << " skipped, longest catch-up " << t.longest_catch_up());
+  CHECK(t.ticks() >= 20);
+  CHECK(t.skipped() >= 20);          // each tick's overrun piles up until it is skipped
+  CHECK(t.longest_catch_up() >= 1);  // late ticks did run back to back ...
+  CHECK(t.longest_catch_up() <= 3);  // ... but never more than the bound
+}
