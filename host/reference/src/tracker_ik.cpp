@@ -158,7 +158,8 @@ IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calib
                          o.trunk_follows_pelvis <= 1.0 && o.trunk_tilts_with_pelvis >= 0.0 &&
                          o.trunk_tilts_with_pelvis <= 1.0 && o.chest_share <= 1.0 && o.neck_share <= 1.0 &&
                          o.hands_heading_weight >= 0.0 && o.neck_back_pole_weight >= 0.0 && o.clavicle_share >= 0.0 &&
-                         o.clavicle_raise_share >= 0.0 && o.default_pole_weight >= 0.0 && o.elbow_stay_weight >= 0.0;
+                         o.clavicle_raise_share >= 0.0 && o.default_pole_weight >= 0.0 && o.elbow_stay_weight >= 0.0 &&
+                         o.elbow_roll_weight >= 0.0;
   if (!(times_ok && sizes_ok && shares_ok)) {
     c.error = "tracker IK: an option is out of range (times and lengths must be positive, shares in [0, 1])";
     return c;
@@ -408,15 +409,22 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     // some of the anatomical pole (down, back, out); an elbow tracker wins.
     // Only the parts across the shoulder-wrist line count, the hand's
     // weighted by its own size: a hand pointing nearly along the arm says
-    // little about the elbow, and must not flip it.
+    // little about the elbow, and must not flip it. The hand's roll says
+    // more: the elbow is a hinge, so with the wrist untwisted its axis is the
+    // hand's, and the elbow lies across the line from it. The wrist's twist
+    // (pronation) is wide, so it is a weak cue, but a flailing arm's hand
+    // keeps it where the pointing alone put the elbow against the upper
+    // arm's twist range, which then swept it (the kicks).
     const Vec3 hand_dir = target.rot * m.rest_dir[bi(hand)];
     const Vec3 anatomic = chest * Vec3(-0.4, 0.3 * rest_arm.y(), -1.0);
     const Vec3 line = target.pos_m - shoulder;
     const Vec3 along = line.norm() > 1e-9 ? Vec3(line.normalized()) : Vec3(chest * -Vec3::UnitZ());
     const auto across_line = [&](const Vec3& v) { return Vec3(v - v.dot(along) * along); };
     const Vec3 hand_part = across_line(-hand_dir);
+    const Vec3 roll_part = along.cross(target.rot * m.hinge_axis[bi(fore)]);  // across the line, |sin|
     const Vec3 raw_pole =
-        chest.conjugate() * (hand_part.norm() * hand_part + o.default_pole_weight * across_line(anatomic.normalized()));
+        chest.conjugate() * (hand_part.norm() * hand_part + o.default_pole_weight * across_line(anatomic.normalized()) +
+                             o.elbow_roll_weight * roll_part);
     // Smoothed in the chest's frame: a hand's quick turns are the wrist's.
     smooth_pole(st.elbow_pole[s], raw_pole, chest.conjugate() * anatomic.normalized(), !st.started,
                 detail::first_order_share(dt, o.elbow_smoothing_s));

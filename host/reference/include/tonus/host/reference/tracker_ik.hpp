@@ -64,6 +64,7 @@ struct IkOptions {
   double clavicle_raise_share = 0.25;  // added in proportion to how far above the shoulder the hand is
   double default_pole_weight = 0.25;   // elbows: the anatomical pole (down, back) against the hand's
   double elbow_stay_weight = 3.0;      // a bent arm's elbow kept on its last side, against the smoothed cue's 1
+  double elbow_roll_weight = 0.5;      // elbows: the hand's roll (the elbow's axis, least wrist twist) against it
   double arm_softness_m = 0.002;       // soft reach near a straight arm (the wrist short by at most 0.37 of it)
   double leg_softness_m = 0.0;         // ... and leg, always (0: a standing leg straight, its foot on the floor)
   // Procedural feet (3 points) only: a soft reach that fades in with the
