@@ -426,6 +426,14 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
         chest.conjugate() * (hand_part.norm() * hand_part + o.default_pole_weight * across_line(anatomic.normalized()) +
                              o.elbow_roll_weight * roll_part);
     // Smoothed in the chest's frame: a hand's quick turns are the wrist's.
+    // It is first carried with the shoulder-wrist line's sweep since the last
+    // frame, so a whole arm swinging fast keeps its elbow's side rather than
+    // dragging a cue left behind (a kick's flailing arms, 30 Hz).
+    const Vec3 line_in_chest = chest.conjugate() * along;
+    if (st.started && st.arm_line[s].norm() > 0.5) {
+      st.elbow_pole[s] = (sim::quat_from_two_vectors(st.arm_line[s], line_in_chest) * st.elbow_pole[s]).normalized();
+    }
+    st.arm_line[s] = line_in_chest;
     smooth_pole(st.elbow_pole[s], raw_pole, chest.conjugate() * anatomic.normalized(), !st.started,
                 detail::first_order_share(dt, o.elbow_smoothing_s));
     Vec3 pole = chest * st.elbow_pole[s];

@@ -199,6 +199,7 @@ struct IkState {
   sim::Quat trunk_turn = sim::Quat::Identity();  // the head's turn from the heading, smoothed
   std::array<sim::Vec3, 2> elbow_pole{};         // in the chest's frame, smoothed, unit
   std::array<sim::Vec3, 2> elbow_last{};         // the last solved upper arm's direction, chest's frame
+  std::array<sim::Vec3, 2> arm_line{};           // the last shoulder-to-wrist direction, chest's frame, unit
   std::array<sim::Vec3, 2> knee_pole{};          // in the world, smoothed, unit
   sim::Vec3 last_pelvis = sim::Vec3::Zero();
   sim::Vec3 pelvis_velocity = sim::Vec3::Zero();
