@@ -410,11 +410,11 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     // Only the parts across the shoulder-wrist line count, the hand's
     // weighted by its own size: a hand pointing nearly along the arm says
     // little about the elbow, and must not flip it. The hand's roll says
-    // more: the elbow is a hinge, so with the wrist untwisted its axis is the
-    // hand's, and the elbow lies across the line from it. The wrist's twist
-    // (pronation) is wide, so it is a weak cue, but a flailing arm's hand
-    // keeps it where the pointing alone put the elbow against the upper
-    // arm's twist range, which then swept it (the kicks).
+    // more: the elbow is a hinge, so with the wrist untwisted the elbow's
+    // axis is the hand's, and the elbow lies across the line from that axis.
+    // The wrist twists widely (pronation), so it is a weak cue; without it a
+    // flailing arm's elbow, placed by the pointing alone, ran into the upper
+    // arm's twist range, whose boundary then swept it (the kicks).
     const Vec3 hand_dir = target.rot * m.rest_dir[bi(hand)];
     const Vec3 anatomic = chest * Vec3(-0.4, 0.3 * rest_arm.y(), -1.0);
     const Vec3 line = target.pos_m - shoulder;
