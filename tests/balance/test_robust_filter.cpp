@@ -114,7 +114,7 @@ TEST_CASE("robust balance filter: Bandai Namco walk, balanced under every estima
   CHECK(c.written.balanced());
   // The independent estimator disagrees at heel strikes (its heel lands one
   // or two frames later, so the ZMP, already on the landing heel, is ahead of
-  // its support): measured 37 of 195 (140 before). The goal (2 %) is not met.
+  // its support): measured 39 of 195 (140 before). The goal (2 %) is not met.
   CHECK(c.independent_after <= 45);
   CHECK(c.independent_after * 3 < c.independent_before);
 }
@@ -124,11 +124,11 @@ TEST_CASE("robust balance filter: CMU walk (bundled), most frames balanced under
   RobustFilterOptions o;
   o.max_iterations = 40;
   const Checked c = run("CMU walk", test::bundled_clip("cmu_02_walk.bvh"), indep::kCmuUnit_m, 1, o);
-  // Measured: at most 16 of 342 under the worst member (4 Hz; 226 before
-  // under the worst, 12 Hz), 41 of 343 under the independent estimator (73
+  // Measured: at most 18 of 342 under the worst member (4 Hz; 226 before
+  // under the worst, 12 Hz), 33 of 343 under the independent estimator (73
   // before). The goal (2 %, 7 frames) is not met.
   CHECK(c.written.members[c.written.worst].outside <= 20);
-  CHECK(c.independent_after <= 48);
+  CHECK(c.independent_after <= 40);
   CHECK(c.independent_after < c.independent_before);
 }
 
@@ -136,12 +136,12 @@ TEST_CASE("robust balance filter: Bandai Namco kicks, the kicking leg swings wit
           tonus::test::heavy_under_sanitizers()) {
   const Checked c =
       run("Bandai kicks", test::shared_clip("dataset-1_kick_normal_001.bvh"), indep::kCentimetre_m, 0, {});
-  // Measured: at most 9 of 358 under the worst member (12 Hz full; 148
-  // before), 73 under the independent estimator (131 before). With the
-  // swinging foot kept where the capture has it, the worst member found 84.
+  // Measured (40 iterations): at most 8 of 358 under the worst member (12 Hz
+  // particle; 148 before), 64 under the independent estimator (131 before).
+  // With the swinging foot kept where the capture has it, the worst member found 84.
   CHECK(c.written.members[c.written.worst].outside <= 12);
   CHECK(c.written.members[c.written.worst].share() <= 0.035);
-  CHECK(c.independent_after <= 80);
+  CHECK(c.independent_after <= 72);
 }
 
 TEST_CASE("robust balance filter: a clip balanced under every estimator is left exactly as it is") {

@@ -78,7 +78,10 @@ int run(int argc, char** argv) {
                     "ZMP preview control)");
   zmp_cmd->add_option("--lookahead", zmp.lookahead_s, "--online: how far ahead the filter sees, s")
       ->check(CLI::Range(0.001, 0.25));
-  zmp_cmd->add_option("--margin", zmp.margin_m, "Aim this far inside the support polygon, m")
+  zmp_cmd
+      ->add_option(
+          "--margin", zmp.margin_m,
+          "Aim this far inside the support polygon, m (default: the correction's own; 1 cm, the robust filter 2 cm)")
       ->check(CLI::Range(0.0, 0.05));
   zmp_cmd->add_option("--max-correction", zmp.max_correction_rad, "Largest waist rotation per frame, rad")
       ->check(CLI::Range(0.01, 2.0));

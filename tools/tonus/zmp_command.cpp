@@ -191,7 +191,7 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
   ao.contacts.foot_length_m = opt.foot_length_m;
   ao.contacts.ground_z_m = opt.ground_height_m;
   if (opt.correction != "rotation" && opt.correction != "waist") return fail("--correction: rotation or waist");
-  fo.margin_m = opt.margin_m;
+  if (opt.margin_m >= 0.0) fo.margin_m = opt.margin_m;
   fo.max_correction_rad = opt.max_correction_rad;
   fo.max_iterations = opt.max_iterations;
 
@@ -220,7 +220,7 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
   } else if (opt.correction == "waist") {
     balance::RobustFilterOptions ro;
     ro.analysis = ao;
-    ro.margin_m = opt.margin_m;
+    if (opt.margin_m >= 0.0) ro.margin_m = opt.margin_m;
     ro.max_iterations = opt.max_iterations;
     balance::RobustFilterResult robust = balance::robust_balance_filter(conv.motion, ro, on_progress, &progress);
     if (progress.show) fmt::print(stderr, "\n");

@@ -30,7 +30,7 @@ struct ZmpCommandOptions {
   std::string correction = "rotation";  // rotation (waist rotation, one estimator) or waist (robust filter)
   bool online = false;                  // the streaming filter (pelvis shift by preview control, bounded look-ahead)
   double lookahead_s = 0.25;            // --online: how far ahead it sees, s (at most 0.25)
-  double margin_m = 0.01;
+  double margin_m = -1.0;               // negative: the correction's own (rotation 1 cm, waist 2 cm, online 1 cm)
   double max_correction_rad = 1.0;
   int max_iterations = 100;
   bool keep_tpose = false;

@@ -52,7 +52,27 @@ struct Layer {
 struct Member {
   AnalysisOptions options;
   AccelOperator op;
+  // Full form: each segment's axis acceleration in the original (D applied to
+  // its axis series), from which a correction's change of the segments' own
+  // angular momentum rate is taken.
+  std::vector<std::array<Vec3, kSegmentParts>> axis_acc;  // [frame from the first analysed]
 };
+
+// D x for one segment quantity over the analysed frames (x: its series).
+template <typename Get>
+std::vector<std::array<Vec3, kSegmentParts>> apply_operator(const AccelOperator& op, std::size_t first, Get get) {
+  std::vector<std::array<Vec3, kSegmentParts>> out(op.n);
+  for (auto& f : out) f.fill(Vec3::Zero());
+  for (std::size_t jj = 0; jj < op.n; ++jj) {
+    const std::size_t lo = jj > op.band ? jj - op.band : 0, hi = std::min(op.n - 1, jj + op.band);
+    for (std::size_t kk = lo; kk <= hi; ++kk) {
+      const double w = op.at(kk, jj);
+      if (w == 0.0) continue;
+      for (std::size_t i = 0; i < kSegmentParts; ++i) out[kk][i] += w * get(first + jj, i);
+    }
+  }
+  return out;
+}
 
 // The motion under one set of knots: each frame's correction, pose and segments.
 struct Corrected {
@@ -247,6 +267,31 @@ Evaluation evaluate(const Problem& p, const Eigen::VectorXd& q) {
         for (std::size_t i = 0; i < kSegmentParts; ++i) acc[first + kk][i] += w * dx[i];
       }
     }
+    // Full form: the segments' own angular momentum rate, m rg^2 axis x axis'',
+    // changes with their axes; the original's rate plus that change.
+    std::vector<Vec3> rate;
+    const Member& mem = p.members[mi];
+    if (!mem.axis_acc.empty()) {
+      rate = a.angular_momentum_rate;
+      std::vector<std::array<Vec3, kSegmentParts>> axis_acc = mem.axis_acc;
+      for (const std::size_t j : changed) {
+        const std::size_t jj = j - first;
+        const std::size_t lo = jj > op.band ? jj - op.band : 0, hi = std::min(op.n - 1, jj + op.band);
+        std::array<Vec3, kSegmentParts> dx;
+        for (std::size_t i = 0; i < kSegmentParts; ++i) dx[i] = e.motion.segments[j][i].axis - a.segments[j][i].axis;
+        for (std::size_t kk = lo; kk <= hi; ++kk) {
+          const double w = op.at(kk, jj);
+          if (w == 0.0) continue;
+          for (std::size_t i = 0; i < kSegmentParts; ++i) axis_acc[kk][i] += w * dx[i];
+        }
+      }
+      for (std::size_t t = first; t < n; ++t) {
+        for (std::size_t i = 0; i < kSegmentParts; ++i) {
+          rate[t] += segment_angular_momentum(a.mass, i, e.motion.segments[t][i], axis_acc[t - first][i]) -
+                     segment_angular_momentum(a.mass, i, a.segments[t][i], mem.axis_acc[t - first][i]);
+        }
+      }
+    }
     e.zmp[mi].assign(n, Vec2::Zero());
     e.distance[mi].assign(n, -1e300);
     for (std::size_t t = first; t < n; ++t) {
@@ -255,7 +300,7 @@ Evaluation evaluate(const Problem& p, const Eigen::VectorXd& q) {
       ZmpInputs in;
       in.segments = &e.motion.segments[t];
       in.accel = &acc[t];
-      in.angular_momentum_rate = a.angular_momentum_rate[t];  // held: the correction turns slowly
+      in.angular_momentum_rate = rate.empty() ? a.angular_momentum_rate[t] : rate[t];
       const ZmpResult z = zero_moment_point(a.mass, in, a.contacts.ground_z_m, p.members[mi].options.gravity);
       if (!z.defined) continue;
       e.zmp[mi][t] = z.zmp;
@@ -342,7 +387,12 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
   const std::size_t m = n - first;
   std::vector<Member> members;
   for (const AnalysisOptions& mo : r.members) {
-    members.push_back({mo, detail::accel_operator(m, motion.dt_s, mo.derivatives)});
+    members.push_back({mo, detail::accel_operator(m, motion.dt_s, mo.derivatives), {}});
+    if (mo.angular_momentum) {
+      const Analysis& base = r.before[members.size() - 1];
+      members.back().axis_acc = apply_operator(members.back().op, first,
+                                               [&](std::size_t t, std::size_t i) { return base.segments[t][i].axis; });
+    }
     r.lookahead_frames = std::max(r.lookahead_frames, members.back().op.band);
   }
 
@@ -400,7 +450,7 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
   for (r.iterations = 0; r.iterations < o.max_iterations; ++r.iterations) {
     if (progress != nullptr) progress(r.iterations, worst_outside(now, kFamilyThreshold_m), user);
     // Each frame's segments under a small change of each of its correction's components.
-    std::vector<std::array<std::array<Vec3, kSegmentParts>, kDof>> dcom(n);
+    std::vector<std::array<std::array<Vec3, kSegmentParts>, kDof>> dcom(n), daxis(n);
     std::vector<bool> needed(n, false);
     for (std::size_t mi = 0; mi < members.size(); ++mi) {
       for (std::size_t t = first; t < n; ++t) {
@@ -425,6 +475,8 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
             r.before.front().mass, correct_waist(motion.frames[t], rot, sh, nullptr, nullptr, p.follow[t]).p);
         for (std::size_t i = 0; i < kSegmentParts; ++i)
           dcom[t][e][i] = (moved[i].com - now.motion.segments[t][i].com) / h;
+        for (std::size_t i = 0; i < kSegmentParts; ++i)
+          daxis[t][e][i] = (moved[i].axis - now.motion.segments[t][i].axis) / h;
       }
     }
     if (!any) break;  // no frame near an edge under any member: nothing to correct
@@ -450,6 +502,20 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
           along_pos[i] = normal.transpose() * dp.dpos[i];
           along_acc[i] = normal.transpose() * dp.dacc[i];
         }
+        // Full form: the ZMP moves by (rate_x n_y - rate_y n_x) / N with the
+        // segments' own angular momentum rate, m rg^2 axis x axis''.
+        const bool full = !members[mi].axis_acc.empty();
+        std::array<Eigen::RowVector3d, kSegmentParts> along_axis_acc;
+        if (full) {
+          double big_n = 0.0;
+          for (std::size_t i = 0; i < kSegmentParts; ++i)
+            big_n += a.mass.parts[i].mass_kg * (now.acc[mi][t][i].z() + members[mi].options.gravity);
+          const Vec3 r_vec = Vec3(normal.y(), -normal.x(), 0.0) / big_n;
+          for (std::size_t i = 0; i < kSegmentParts; ++i)
+            for (Eigen::Index c = 0; c < 3; ++c)
+              along_axis_acc[i](c) =
+                  r_vec.dot(segment_angular_momentum(a.mass, i, now.motion.segments[t][i], Vec3::Unit(c)));
+        }
         const std::size_t kk = t - first;
         const std::size_t lo = kk > op.band ? kk - op.band : 0, hi = std::min(m - 1, kk + op.band);
         touched.clear();
@@ -462,6 +528,7 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
               const Vec3& dc = dcom[first + jj][e][i];
               g[e] += w * along_acc[i].dot(dc);
               if (jj == kk) g[e] += along_pos[i].dot(dc);
+              if (full) g[e] += w * along_axis_acc[i].dot(daxis[first + jj][e][i]);
             }
           }
           for (const Layer& l : p.layers) {
