@@ -27,16 +27,21 @@ class StallingTarget final : public TickTarget {
   int non_increasing = 0;
 };
 
+// 1 kHz, no real-time privileges asked (tests run unprivileged).
+PacingConfig paced_at_1khz(int max_catch_up_ticks) {
+  PacingConfig c;
+  c.rate_hz = 1000.0;
+  c.max_catch_up_ticks = max_catch_up_ticks;
+  c.realtime_priority = 0;
+  c.lock_memory = false;
+  return c;
+}
+
 }  // namespace
 
 TEST_CASE("pacing: a long stall is skipped, a short one caught up, the schedule never drifts or spirals") {
   StallingTarget target;
-  PacingConfig c;
-  c.rate_hz = 1000.0;
-  c.max_catch_up_ticks = 4;
-  c.realtime_priority = 0;
-  c.lock_memory = false;
-  PhysicsThread t(target, c);
+  PhysicsThread t(target, paced_at_1khz(4));
   const auto t0 = std::chrono::steady_clock::now();
   t.start();
   std::this_thread::sleep_for(std::chrono::milliseconds(800));
@@ -74,12 +79,7 @@ class SlowTarget final : public TickTarget {
 
 TEST_CASE("pacing: a thread kept behind on every tick never runs more than max_catch_up_ticks late ticks in a row") {
   SlowTarget target;
-  PacingConfig c;
-  c.rate_hz = 1000.0;
-  c.max_catch_up_ticks = 3;
-  c.realtime_priority = 0;
-  c.lock_memory = false;
-  PhysicsThread t(target, c);
+  PhysicsThread t(target, paced_at_1khz(3));
   t.start();
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   t.stop();

@@ -238,6 +238,25 @@ Eigen::SparseMatrix<double> regulariser_matrix(const std::vector<Layer>& layers,
   return r;
 }
 
+// out[k] += D[k, j] dx(j) over the changed frames j (clip frames; the
+// operator's rows and columns count from `first`): a linear derivative of
+// the original plus the operator applied to the change.
+template <class Delta>
+void add_operator_change(const AccelOperator& op, const std::vector<std::size_t>& changed, std::size_t first,
+                         std::array<Vec3, kSegmentParts>* out, const Delta& delta) {
+  for (const std::size_t j : changed) {
+    const std::size_t jj = j - first;
+    const std::size_t lo = jj > op.band ? jj - op.band : 0, hi = std::min(op.n - 1, jj + op.band);
+    std::array<Vec3, kSegmentParts> dx;
+    for (std::size_t i = 0; i < kSegmentParts; ++i) dx[i] = delta(j, i);
+    for (std::size_t kk = lo; kk <= hi; ++kk) {
+      const double w = op.at(kk, jj);
+      if (w == 0.0) continue;
+      for (std::size_t i = 0; i < kSegmentParts; ++i) out[kk][i] += w * dx[i];
+    }
+  }
+}
+
 Evaluation evaluate(const Problem& p, const Eigen::VectorXd& q) {
   Evaluation e;
   e.motion = correct(p, q);
@@ -256,17 +275,9 @@ Evaluation evaluate(const Problem& p, const Eigen::VectorXd& q) {
     auto& acc = e.acc[mi];
     acc = a.accelerations;
     // a(x + dx) = a(x) + D dx: only the changed frames contribute.
-    for (const std::size_t j : changed) {
-      const std::size_t jj = j - first;
-      const std::size_t lo = jj > op.band ? jj - op.band : 0, hi = std::min(op.n - 1, jj + op.band);
-      std::array<Vec3, kSegmentParts> dx;
-      for (std::size_t i = 0; i < kSegmentParts; ++i) dx[i] = e.motion.segments[j][i].com - a.segments[j][i].com;
-      for (std::size_t kk = lo; kk <= hi; ++kk) {
-        const double w = op.at(kk, jj);
-        if (w == 0.0) continue;
-        for (std::size_t i = 0; i < kSegmentParts; ++i) acc[first + kk][i] += w * dx[i];
-      }
-    }
+    add_operator_change(op, changed, first, acc.data() + first, [&](std::size_t j, std::size_t i) {
+      return Vec3(e.motion.segments[j][i].com - a.segments[j][i].com);
+    });
     // Full form: the segments' own angular momentum rate, m rg^2 axis x axis'',
     // changes with their axes; the original's rate plus that change.
     std::vector<Vec3> rate;
@@ -274,17 +285,9 @@ Evaluation evaluate(const Problem& p, const Eigen::VectorXd& q) {
     if (!mem.axis_acc.empty()) {
       rate = a.angular_momentum_rate;
       std::vector<std::array<Vec3, kSegmentParts>> axis_acc = mem.axis_acc;
-      for (const std::size_t j : changed) {
-        const std::size_t jj = j - first;
-        const std::size_t lo = jj > op.band ? jj - op.band : 0, hi = std::min(op.n - 1, jj + op.band);
-        std::array<Vec3, kSegmentParts> dx;
-        for (std::size_t i = 0; i < kSegmentParts; ++i) dx[i] = e.motion.segments[j][i].axis - a.segments[j][i].axis;
-        for (std::size_t kk = lo; kk <= hi; ++kk) {
-          const double w = op.at(kk, jj);
-          if (w == 0.0) continue;
-          for (std::size_t i = 0; i < kSegmentParts; ++i) axis_acc[kk][i] += w * dx[i];
-        }
-      }
+      add_operator_change(op, changed, first, axis_acc.data(), [&](std::size_t j, std::size_t i) {
+        return Vec3(e.motion.segments[j][i].axis - a.segments[j][i].axis);
+      });
       for (std::size_t t = first; t < n; ++t) {
         for (std::size_t i = 0; i < kSegmentParts; ++i) {
           rate[t] += segment_angular_momentum(a.mass, i, e.motion.segments[t][i], axis_acc[t - first][i]) -
