@@ -91,37 +91,72 @@ Crosschecked crosscheck(const std::string& name, const std::string& path, double
 // does not meet yet (docs/balance.md, "The online filter").
 TEST_CASE("online balance filter, crosschecked: Bandai walk, fewer frames outside, within 2.3 cm RMS of offline" *
           tonus::test::heavy_under_sanitizers()) {
-  // 140 -> 91 of 195; 2.01 cm RMS, 7.0 max.
+  // 140 -> 81 of 195; 2.07 cm RMS, 6.5 max (2026-12-04, errors weighted by
+  // the support ratio; 91 and 2.01 / 7.0 before).
   const Crosschecked c =
       crosscheck("Bandai walk", test::shared_clip("dataset-1_walk_normal_001.bvh"), indep::kCentimetre_m, 0);
   CHECK(c.independent_after < c.independent_before);
-  CHECK(c.independent_after <= 96);
+  CHECK(c.independent_after <= 86);
   CHECK(c.online_to_offline.rms_m < 0.023);
-  CHECK(c.online_to_offline.max_m < 0.08);
+  CHECK(c.online_to_offline.max_m < 0.072);
 }
 
-TEST_CASE("online balance filter, crosschecked: Bandai kicks, fewer frames outside, within 3.4 cm RMS of offline" *
+TEST_CASE("online balance filter, crosschecked: Bandai kicks, fewer frames outside, within 2.7 cm RMS of offline" *
           tonus::test::heavy_under_sanitizers()) {
-  // 131 -> 112 of 358; 3.01 cm RMS, 8.2 max.
+  // 131 -> 108 of 358; 2.41 cm RMS, 6.5 max (112 and 3.01 / 8.2 before).
   const Crosschecked c =
       crosscheck("Bandai kicks", test::shared_clip("dataset-1_kick_normal_001.bvh"), indep::kCentimetre_m, 0);
   CHECK(c.independent_after < c.independent_before);
-  CHECK(c.independent_after <= 117);
-  CHECK(c.online_to_offline.rms_m < 0.034);
-  CHECK(c.online_to_offline.max_m < 0.095);
+  CHECK(c.independent_after <= 113);
+  CHECK(c.online_to_offline.rms_m < 0.027);
+  CHECK(c.online_to_offline.max_m < 0.072);
 }
 
 TEST_CASE(
-    "online balance filter, crosschecked: CMU walk, within 3 cm RMS of offline (and worse under the "
+    "online balance filter, crosschecked: CMU walk, within 2.7 cm RMS of offline (and worse under the "
     "independent estimator)" *
     tonus::test::heavy_under_sanitizers()) {
-  // 73 -> 101 of 343: the correction pushes more frames outside than it
-  // brings in under this estimator (the family's 6 Hz member: 122 -> 116).
-  // 2.76 cm RMS, 5.7 max.
+  // 73 -> 96 of 343: the correction pushes more frames outside than it
+  // brings in under this estimator (the family's 6 Hz member: 122 -> 115).
+  // 2.43 cm RMS, 5.4 max (101 and 2.76 / 5.7 before).
   const Crosschecked c = crosscheck("CMU walk", test::bundled_clip("cmu_02_walk.bvh"), indep::kCmuUnit_m, 1);
-  CHECK(c.independent_after <= 107);
-  CHECK(c.online_to_offline.rms_m < 0.03);
+  CHECK(c.independent_after <= 101);
+  CHECK(c.online_to_offline.rms_m < 0.027);
+  CHECK(c.online_to_offline.max_m < 0.06);
+}
+
+TEST_CASE(
+    "online balance filter, crosschecked: Bandai punches, within 3.4 cm RMS of offline (and worse under the "
+    "independent estimator)" *
+    tonus::test::heavy_under_sanitizers()) {
+  // 99 -> 104 of 224, though every member of the family improves (6 Hz
+  // particle 108 -> 76): the boxer's bounce, where the ZMP is most
+  // sensitive, is where the estimators part. 3.09 cm RMS, 5.9 max.
+  const Crosschecked c =
+      crosscheck("Bandai punches", test::shared_clip("dataset-1_punch_normal_001.bvh"), indep::kCentimetre_m, 0);
+  CHECK(c.independent_after <= 109);
+  CHECK(c.online_to_offline.rms_m < 0.034);
   CHECK(c.online_to_offline.max_m < 0.065);
+}
+
+TEST_CASE("online balance filter, crosschecked: Bandai run, within 4.1 cm RMS of offline" *
+          tonus::test::heavy_under_sanitizers()) {
+  // 21 -> 21 of 35; 3.73 cm RMS, 6.8 max: flight phases leave few frames to
+  // correct, and the online edit (4.2 cm RMS) is larger than the offline one.
+  const Crosschecked c =
+      crosscheck("Bandai run", test::shared_clip("dataset-2_run_normal_010.bvh"), indep::kCentimetre_m, 0);
+  CHECK(c.independent_after <= 23);
+  CHECK(c.online_to_offline.rms_m < 0.041);
+  CHECK(c.online_to_offline.max_m < 0.075);
+}
+
+TEST_CASE("online balance filter, crosschecked: Bandai waving, balanced throughout, left as it was" *
+          tonus::test::heavy_under_sanitizers()) {
+  const Crosschecked c = crosscheck("Bandai waving", test::shared_clip("dataset-2_wave-both-hands_normal_001.bvh"),
+                                    indep::kCentimetre_m, 0);
+  CHECK(c.independent_before == 0);
+  CHECK(c.independent_after == 0);
+  CHECK(c.online_to_offline.rms_m < 0.005);
 }
 
 }  // namespace tonus::balance

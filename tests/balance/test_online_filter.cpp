@@ -200,8 +200,10 @@ TEST_CASE("online balance filter: the fine layer takes capture jitter out, which
 }
 
 TEST_CASE("online balance filter: anti-windup, where the cap binds, takes the kicks' overshoots out") {
-  // Bandai kicks, 4 Hz particle: 146 before; 121 after with a cart that
-  // winds up at the 8 cm cap, 109 with anti-windup (measured).
+  // Bandai kicks, 4 Hz particle: 146 before; 111 after with a cart that
+  // winds up at the 8 cm cap, 107 with anti-windup (measured; the errors
+  // weighted by the support ratio). The 4 Hz members, which see the slow
+  // overshoot, gain most; the others are within a frame either way.
   const test::Loaded l = test::load(test::shared_clip("dataset-1_kick_normal_001.bvh"));
   const HumanMotion& m = l.conversion.motion;
   OnlineOptions o = options_for(m);
@@ -219,8 +221,15 @@ TEST_CASE("online balance filter: anti-windup, where the cap binds, takes the ki
                                           << after_with.members[0].outside << " with anti-windup; " << capped
                                           << " frames capped");
   CHECK(capped > 0);
-  for (std::size_t i = 0; i < members.size(); ++i)
-    CHECK(after_with.members[i].outside < after_without.members[i].outside);
+  std::size_t total_with = 0, total_without = 0;
+  for (std::size_t i = 0; i < members.size(); ++i) {
+    total_with += after_with.members[i].outside;
+    total_without += after_without.members[i].outside;
+    CHECK(after_with.members[i].outside <= after_without.members[i].outside + 1);
+  }
+  CHECK(after_with.members[0].outside + 3 <= after_without.members[0].outside);  // 4 Hz particle
+  CHECK(after_with.members[1].outside + 3 <= after_without.members[1].outside);  // 4 Hz full
+  CHECK(total_with + 10 <= total_without);
 }
 
 TEST_CASE("online balance filter: a non-finite frame is taken as the one before, counted, and nothing out is NaN") {

@@ -12,6 +12,8 @@ namespace tonus::balance {
 namespace {
 
 constexpr double kMaxDrop_m = 0.008;
+// The least weight of a frame's ZMP error (its support ratio, below).
+constexpr double kMinErrorWeight = 0.2;
 
 bool finite_frame(const MotionFrame& f) {
   for (const Vec3& p : f.p) {
@@ -160,8 +162,12 @@ void OnlineBalance::window_errors() {
     outside_[w] = signed_distance(poly, z.zmp);
     if (outside_[w] > -options_.margin_m) {
       const Vec2 target = nearest_point_inset(poly, z.zmp, options_.margin_m);
-      errors_[0][w] = target.x() - z.zmp.x();
-      errors_[1][w] = target.y() - z.zmp.y();
+      // Where the feet carry only part of the weight (a bounce's trough), a
+      // shift's acceleration moves the ZMP by the inverse of that share, and
+      // the estimators disagree most: the cart asks for the share of the move.
+      const double weight = std::clamp(z.support_ratio, kMinErrorWeight, 1.0);
+      errors_[0][w] = weight * (target.x() - z.zmp.x());
+      errors_[1][w] = weight * (target.y() - z.zmp.y());
     }
   }
 }
