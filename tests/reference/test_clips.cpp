@@ -83,6 +83,8 @@ TEST_CASE("reference: the balance stage before retargeting (tonusd's tracker.bal
   REQUIRE_MESSAGE(online.ok(), online.error);
   MESSAGE(online.balance);
   CHECK(online.balance.find("balance (online, look-ahead 30 frames)") == 0);
+  CHECK(online.balance.find("; under the worst estimator of the family after (") != std::string::npos);
+  CHECK(online.balance.find("(not balanced under every estimator)") != std::string::npos);  // docs/balance.md
   CHECK(std::find(online.messages.begin(), online.messages.end(), online.balance) != online.messages.end());
   REQUIRE(online.qpos.size() == off.qpos.size());
   // The pelvis moves sideways and back by at most the filter's cap (8 cm per

@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "tonus/host/balance/family.hpp"
-#include "tonus/host/balance/filter.hpp"
+#include "tonus/host/balance/robust_filter.hpp"
 
 namespace tonus::balance {
 
@@ -24,17 +24,31 @@ BalanceStageResult balance_stage(const HumanMotion& motion, const BalanceStageOp
   try {
     const AnalysisOptions& analysis = options.analysis;
     Analysis before, after;
+    FamilyVerdict family_after;
     if (options.mode == BalanceMode::offline) {
-      FilterOptions fo;
-      fo.analysis = analysis;
-      FilterResult f = balance_filter(motion, fo);
+      RobustFilterOptions ro;
+      ro.analysis = analysis;
+      RobustFilterResult f = robust_balance_filter(motion, ro);
       if (!f.ok()) {
         r.error = "offline balance filter: " + f.error;
         return r;
       }
       r.motion = std::move(f.corrected);
-      before = std::move(f.before);  // the filter analysed both already
-      after = std::move(f.after);
+      family_after = std::move(f.verdict_after);  // the filter analysed the family already
+      // The base estimator is a member when its cut-off is one of the family's.
+      bool found = false;
+      for (std::size_t i = 0; i < f.members.size() && !found; ++i) {
+        found = f.members[i].derivatives.cutoff_hz == analysis.derivatives.cutoff_hz &&
+                f.members[i].angular_momentum == analysis.angular_momentum;
+        if (found) {
+          before = std::move(f.before[i]);
+          after = std::move(f.after[i]);
+        }
+      }
+      if (!found) {
+        before = analyse(motion, analysis, &f.before.front().contacts);
+        after = analyse(r.motion, analysis, &f.before.front().contacts);
+      }
     } else {
       OnlineOptions oo;
       oo.analysis = analysis;
@@ -54,6 +68,8 @@ BalanceStageResult balance_stage(const HumanMotion& motion, const BalanceStageOp
         return r;
       }
       after = analyse(r.motion, analysis, &before.contacts);
+      const std::vector<AnalysisOptions> members = estimator_family(analysis);
+      family_after = family_verdict(analyse_family(r.motion, members, before.contacts), members);
     }
     // Counted as the estimator family counts: frames with a foot down and the
     // ZMP defined, outside by more than kFamilyThreshold_m (1 cm).
@@ -62,6 +78,13 @@ BalanceStageResult balance_stage(const HumanMotion& motion, const BalanceStageOp
     r.frames_outside_before = b.outside;
     r.frames_outside_after = family_verdict({after}, one).members.front().outside;
     r.supported_frames = b.supported;
+    if (!family_after.members.empty()) {
+      const MemberVerdict& w = family_after.members[family_after.worst];
+      r.worst_member_outside_after = w.outside;
+      r.worst_member_cutoff_hz = w.cutoff_hz;
+      r.worst_member_full = w.full;
+      r.balanced = family_after.balanced();
+    }
   } catch (const std::exception& e) {  // an allocation failure on an absurd clip: refuse, keep the input
     r = BalanceStageResult{};
     r.motion = motion;

@@ -202,7 +202,12 @@ ClipReference clip_to_reference(const sim::Model& humanoid, const std::string& b
       }
       balance_note = "balance (" + mode + "): supported frames with the ZMP outside by more than 1 cm: " +
                      std::to_string(balanced.frames_outside_before) + " -> " +
-                     std::to_string(balanced.frames_outside_after) + " of " + std::to_string(balanced.supported_frames);
+                     std::to_string(balanced.frames_outside_after) + " of " +
+                     std::to_string(balanced.supported_frames) + "; under the worst estimator of the family after (" +
+                     std::to_string(static_cast<int>(balanced.worst_member_cutoff_hz)) + " Hz " +
+                     (balanced.worst_member_full ? "full" : "particle") +
+                     "): " + std::to_string(balanced.worst_member_outside_after) +
+                     (balanced.balanced ? " (balanced)" : " (not balanced under every estimator)");
       notes.push_back(balance_note);
     }
     notes.insert(notes.end(), r.messages.begin(), r.messages.end());
