@@ -22,10 +22,15 @@ build/release/bin/tonus demo --seconds 5 --loss 0.01 --duplication 0.002 --reord
 build/release/bin/tonus physics --seconds 3
 
 # The ZMP balance filter on a bundled CMU walk (tests/data/SOURCES.md): the
-# ZMP checked against the feet's support polygon, the waist corrected where it
-# leaves it, the corrected clip, a JSON report and an SVG plot written.
+# ZMP checked against the feet's support polygon, the waist leaned, turned and
+# shifted where it leaves it, the corrected clip, a JSON report and an SVG plot
+# written, and the written clip judged under every estimator of the family.
+# Exit code 1 is that verdict (on this clip the 4 Hz estimators still find 5 %
+# of the frames outside, docs/balance.md), not a failure of the run; 2 is.
+zmp_status=0
 build/release/bin/tonus zmp tests/data/cmu_02_walk.bvh -o build/release/cmu_02_walk_balanced.bvh \
-  --json build/release/cmu_02_walk_balance.json --svg build/release/cmu_02_walk_balance.svg
+  --json build/release/cmu_02_walk_balance.json --svg build/release/cmu_02_walk_balance.svg || zmp_status=$?
+if [ "$zmp_status" -gt 1 ]; then exit "$zmp_status"; fi
 
 # The avatar controller (dual PD: stiff simulation A feeds forward into weak
 # simulation B): the paper's cube experiment, PD only against PD + feedforward,

@@ -70,8 +70,8 @@ int run(int argc, char** argv) {
   zmp_cmd->add_flag("--full-zmp", zmp.full_zmp, "Include the segments' angular momentum (default: particle form)");
   zmp_cmd
       ->add_option("--correction", zmp.correction,
-                   "Correction: rotation (the waist rotation, under one estimator) or waist (lean, yaw and pelvis "
-                   "shift, robust under the estimator family)")
+                   "Correction: waist (default: lean, yaw and pelvis shift, robust under the estimator family) or "
+                   "rotation (the first design: the waist rotation, under one estimator)")
       ->check(CLI::IsMember({"rotation", "waist"}));
   zmp_cmd->add_flag("--online", zmp.online,
                     "Correct as a stream: each frame from the ones before it and --lookahead ahead (pelvis shift by "
@@ -83,7 +83,9 @@ int run(int argc, char** argv) {
           "--margin", zmp.margin_m,
           "Aim this far inside the support polygon, m (default: the correction's own; 1 cm, the robust filter 2 cm)")
       ->check(CLI::Range(0.0, 0.05));
-  zmp_cmd->add_option("--max-correction", zmp.max_correction_rad, "Largest waist rotation per frame, rad")
+  zmp_cmd
+      ->add_option("--max-correction", zmp.max_correction_rad,
+                   "--correction rotation: largest waist rotation per frame, rad")
       ->check(CLI::Range(0.01, 2.0));
   zmp_cmd->add_option("--iterations", zmp.max_iterations, "Solver iterations at most")->check(CLI::Range(0, 10000));
   zmp_cmd->add_flag("--keep-tpose", zmp.keep_tpose, "Analyse a leading T-pose frame too");

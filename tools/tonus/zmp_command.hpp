@@ -26,21 +26,22 @@ struct ZmpCommandOptions {
   double contact_speed_mps = 0.30;
   std::string derivative = "kalman_spline";  // kalman_spline, kalman, spline, finite_difference
   double cutoff_hz = 6.0;
-  bool full_zmp = false;                // include the segments' angular momentum rate
-  std::string correction = "rotation";  // rotation (waist rotation, one estimator) or waist (robust filter)
-  bool online = false;                  // the streaming filter (pelvis shift by preview control, bounded look-ahead)
-  double lookahead_s = 0.25;            // --online: how far ahead it sees, s (at most 0.25)
-  double margin_m = -1.0;               // negative: the correction's own (rotation 1 cm, waist 2 cm, online 1 cm)
+  bool full_zmp = false;  // include the segments' angular momentum rate
+  std::string correction =
+      "waist";                // waist (the robust filter, the default) or rotation (waist rotation, one estimator)
+  bool online = false;        // the streaming filter (pelvis shift by preview control, bounded look-ahead)
+  double lookahead_s = 0.25;  // --online: how far ahead it sees, s (at most 0.25)
+  double margin_m = -1.0;     // negative: the correction's own (rotation 1 cm, waist 2 cm, online 1 cm)
   double max_correction_rad = 1.0;
   int max_iterations = 100;
   bool keep_tpose = false;
   bool quiet = false;
 };
 
-// Process exit code: 0 when every analysed frame ends inside its support
-// polygon (or airborne) (--correction waist: when the written clip is
-// balanced under every estimator of the family), 1 when frames remain
-// unsolved (not balanced), 2 on bad input.
+// Process exit code: 0 when the written clip is balanced under every
+// estimator of the family (--correction rotation: when every analysed frame
+// ends inside its support polygon, or airborne, under its one estimator), 1
+// when it is not, 2 on bad input.
 int run_zmp_command(const ZmpCommandOptions& options);
 
 }  // namespace tonus::tools
