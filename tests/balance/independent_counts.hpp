@@ -1,10 +1,12 @@
 // The independent estimator's verdict on a clip and on its corrected, written
 // version: frames outside by more than 1 cm before and after, for the tests
-// that judge a filter from outside (balance_crosscheck_tests).
+// that judge a filter from outside (balance_crosscheck_tests); and where the
+// frames still outside after sit against the estimator's own contact timing.
 #pragma once
 
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <cstddef>
 
 #include "independent/zmp_estimator.hpp"
@@ -26,6 +28,52 @@ inline IndependentCounts independent_counts(const motion::Clip& original, const 
   REQUIRE(before.ok());
   REQUIRE(after.ok());
   return {before.summary.outside, after.summary.outside, after.summary.supported};
+}
+
+// Where the independent estimator's frames outside after correction sit:
+// within 0.1 s of one of its own contact changes (a heel or toe landing or
+// lifting), against the share of all its supported frames that are; and how
+// many stay outside when a foot point may land at up to 0.8 m/s (leave at
+// 1.6) instead of 0.4 (0.8), a contact detection that calls a heel strike
+// earlier.
+struct ContactTiming {
+  std::size_t outside = 0, outside_near_change = 0;
+  std::size_t defined = 0, defined_near_change = 0;  // supported frames with the ZMP defined
+  std::size_t outside_fast_landing = 0;
+};
+
+inline ContactTiming contact_timing(const motion::Clip& written, double unit_m, std::size_t first_frame) {
+  indep::Options io;
+  io.metres_per_unit = unit_m;
+  io.first_frame = first_frame;
+  const indep::Estimate e = indep::estimate_zmp(written, io);
+  REQUIRE(e.ok());
+  const auto reach = static_cast<std::size_t>(std::lround(0.1 / written.frame_time_s));
+  const auto near_change = [&](std::size_t t) {
+    for (std::size_t u = t > reach ? t - reach : 1; u <= t + reach && u < e.frames.size(); ++u) {
+      if (e.frames[u].contact != e.frames[u - 1].contact) return true;
+    }
+    return false;
+  };
+  ContactTiming c;
+  for (std::size_t t = 0; t < e.frames.size(); ++t) {
+    const indep::FrameEstimate& f = e.frames[t];
+    if (!f.analysed || !f.supported || !f.zmp_defined) continue;
+    const bool near = near_change(t);
+    ++c.defined;
+    c.defined_near_change += near ? 1U : 0U;
+    if (f.distance_m > io.tolerance_m) {
+      ++c.outside;
+      c.outside_near_change += near ? 1U : 0U;
+    }
+  }
+  indep::Options fast = io;
+  fast.contacts.enter_speed_mps = 0.8;
+  fast.contacts.leave_speed_mps = 1.6;
+  const indep::Estimate f = indep::estimate_zmp(written, fast);
+  REQUIRE(f.ok());
+  c.outside_fast_landing = f.summary.outside;
+  return c;
 }
 
 }  // namespace tonus::balance::test
