@@ -149,7 +149,8 @@ IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calib
                         o.velocity_time_constant_s >= 0.0 && o.landing_follow_s >= 0.0 && o.trunk_smoothing_s >= 0.0 &&
                         o.heading_smoothing_s >= 0.0 && o.waist_heading_smoothing_s >= 0.0 &&
                         o.elbow_smoothing_s >= 0.0 && o.stride_soft_fade_s >= 0.0 && o.knee_smoothing_s >= 0.0 &&
-                        o.tracked_knee_smoothing_s >= 0.0;
+                        o.tracked_knee_smoothing_s >= 0.0 && o.heading_smoothing2_s >= 0.0 &&
+                        o.clavicle_lower_s >= 0.0 && o.chest_twist_smoothing_s >= 0.0;
   const bool sizes_ok = o.step_threshold_m > 0.0 && o.step_turn_rad > 0.0 && o.foot_pivot_start_rad >= 0.0 &&
                         o.foot_pivot_width_rad >= 0.0 && o.step_lift_m >= 0.0 && o.implausible_reach_factor > 1.0 &&
                         o.leg_softness_m >= 0.0 && o.stride_softness_m >= 0.0 && o.stride_soft_speed_mps > 0.0;
@@ -159,7 +160,7 @@ IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calib
                          o.trunk_tilts_with_pelvis <= 1.0 && o.chest_share <= 1.0 && o.neck_share <= 1.0 &&
                          o.hands_heading_weight >= 0.0 && o.neck_back_pole_weight >= 0.0 && o.clavicle_share >= 0.0 &&
                          o.clavicle_raise_share >= 0.0 && o.default_pole_weight >= 0.0 && o.elbow_stay_weight >= 0.0 &&
-                         o.elbow_roll_weight >= 0.0;
+                         o.elbow_roll_weight >= 0.0 && o.chest_twist_reach_factor > 0.0 && o.chest_twist_max_rad >= 0.0;
   if (!(times_ok && sizes_ok && shares_ok)) {
     c.error = "tracker IK: an option is out of range (times and lengths must be positive, shares in [0, 1])";
     return c;
@@ -268,11 +269,22 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
   // The heading smoothed, so the hands' quick swings do not shake the trunk
   // (the head stays exact). 6 points: longer, as it only shapes the trunk
   // the waist tracker carries (a kick's flailing hands turned the chest).
+  // 3 points: two stages, so a quick swing's heading comes in smoothly
+  // rather than with a first-order step's kink (the kicks' flailing hands).
   if (st.started) {
     const bool waist_worn = m.calibration.offset[index(Tracker::waist)].valid;
-    yaw = st.body_yaw_rad +
-          detail::first_order_share(dt, waist_worn ? o.waist_heading_smoothing_s : o.heading_smoothing_s) *
-              std::remainder(yaw - st.body_yaw_rad, 2.0 * std::numbers::pi);
+    const auto follow = [&](double from, double to, double tau) {
+      return from + detail::first_order_share(dt, tau) * std::remainder(to - from, 2.0 * std::numbers::pi);
+    };
+    if (waist_worn) {
+      yaw = follow(st.body_yaw_rad, yaw, o.waist_heading_smoothing_s);
+      st.body_yaw_stage_rad = yaw;
+    } else {
+      st.body_yaw_stage_rad = follow(st.body_yaw_stage_rad, yaw, o.heading_smoothing_s);
+      yaw = follow(st.body_yaw_rad, st.body_yaw_stage_rad, o.heading_smoothing2_s);
+    }
+  } else {
+    st.body_yaw_stage_rad = yaw;
   }
   st.body_yaw_rad = yaw;
   const Quat heading = yaw_quat(yaw);
@@ -400,7 +412,14 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
       const double mid = 0.5 * (lo + hi);
       ((target.pos_m - shoulder_at(mid, clav_local)).norm() > reach_c ? lo : hi) = mid;
     }
-    const double k = std::min(1.0, smooth_max(wanted, hi, kSoftness));
+    // Raised at once, lowered over clavicle_lower_s: a shoulder that dropped
+    // as soon as the reach allowed snapped back (a kick's flung arm). Higher
+    // than the reach needs is still within it.
+    double k = std::min(1.0, smooth_max(wanted, hi, kSoftness));
+    if (st.started && k < st.clavicle_share[s]) {
+      k = st.clavicle_share[s] + detail::first_order_share(dt, o.clavicle_lower_s) * (k - st.clavicle_share[s]);
+    }
+    st.clavicle_share[s] = k;
     shoulder_at(k, clav_local);
     settle_ball(m, w, clav, (chest * clav_local).normalized());
     const Vec3 shoulder = joint_of(w, m, upper);
