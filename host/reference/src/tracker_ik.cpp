@@ -127,6 +127,51 @@ bool reach_head(const Vec3& base, const Vec3& neck_guess, double neck_m, const V
   return dist <= longest && dist >= shortest;
 }
 
+// A two-bone limb whose upper bone (under `parent`, its parent's world
+// rotation) is past its ball joint's range: the middle joint (elbow, knee) is
+// turned about the root-to-target line until the bone is inside, so the end
+// joint stays on its target. Past its twist, the turn follows the excess
+// almost one to one; past its swing cone (or still past its twist), the
+// nearest place inside both is found by a scan both ways, then bisection onto
+// the boundary (so it moves smoothly). `pole` and `sol` are updated.
+void rescue_range(const detail::TwoBoneLimb& limb, const Vec3& root, const Vec3& target, const Vec3& fallback,
+                  const Quat& parent, const sim::JointLimit& lim, Vec3& pole, detail::TwoBoneSolution& sol) {
+  const Vec3 line = target - root;
+  if (!lim.enabled || line.norm() <= 1e-6) return;
+  const Vec3 axis = line.normalized();
+  const auto local_of = [&](const detail::TwoBoneSolution& so) {
+    return Quat((parent.conjugate() * so.upper).normalized());
+  };
+  for (int it = 0; it < kTwistCorrections; ++it) {
+    const double twist = sim::swing_twist(local_of(sol), lim.twist_axis).twist_rad;
+    const double excess = twist - std::clamp(twist, lim.lower_rad + kTwistMargin_rad, lim.upper_rad - kTwistMargin_rad);
+    if (excess == 0.0) break;
+    pole = Eigen::AngleAxisd(-excess, axis) * pole;
+    sol = detail::solve_two_bone(limb, root, target, pole, fallback);
+  }
+  const auto outside = [&](const Vec3& p) {
+    const detail::TwoBoneSolution so = detail::solve_two_bone(limb, root, target, p, fallback);
+    const sim::SwingTwist sw = sim::swing_twist(local_of(so), lim.twist_axis);
+    return sw.swing_rad > lim.swing_max_rad || sw.twist_rad < lim.lower_rad || sw.twist_rad > lim.upper_rad;
+  };
+  if (!outside(pole)) return;
+  double found = 0.0;
+  for (int step = 1; step <= kElbowScanSteps && found == 0.0; ++step) {
+    for (const double sign : {1.0, -1.0}) {
+      const double a = sign * step * kElbowScanStep_rad;
+      if (found == 0.0 && !outside(Eigen::AngleAxisd(a, axis) * pole)) found = a;
+    }
+  }
+  if (found == 0.0) return;
+  double inside = found, beyond = found - std::copysign(kElbowScanStep_rad, found);
+  for (int it = 0; it < kElbowBisections; ++it) {
+    const double mid = 0.5 * (inside + beyond);
+    (outside(Eigen::AngleAxisd(mid, axis) * pole) ? beyond : inside) = mid;
+  }
+  pole = Eigen::AngleAxisd(inside, axis) * pole;
+  sol = detail::solve_two_bone(limb, root, target, pole, fallback);
+}
+
 }  // namespace
 
 IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calibration, const IkOptions& options) {
@@ -476,45 +521,7 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     const Vec3 pole_free = pole;  // before the ranges turn it
     // An elbow the upper arm cannot twist to is turned about the shoulder-wrist
     // line until it can (the twist follows that turn almost one to one).
-    const sim::JointLimit& lim = m.limit[bi(upper)];
-    const auto local_of = [&](const detail::TwoBoneSolution& so) {
-      return Quat((w.f.rot[bi(clav)].conjugate() * so.upper).normalized());
-    };
-    for (int it = 0; it < kTwistCorrections && line.norm() > 1e-6; ++it) {
-      const double twist = sim::swing_twist(local_of(sol), lim.twist_axis).twist_rad;
-      const double excess =
-          twist - std::clamp(twist, lim.lower_rad + kTwistMargin_rad, lim.upper_rad - kTwistMargin_rad);
-      if (excess == 0.0) break;
-      pole = Eigen::AngleAxisd(-excess, line.normalized()) * pole;
-      sol = detail::solve_two_bone(limb, shoulder, target.pos_m, pole, anatomic);
-    }
-    // An upper arm past its swing cone (or still past its twist): the elbow
-    // is turned about the line to the nearest place inside both, found by a
-    // scan both ways, then bisection onto the boundary (so it moves smoothly).
-    const auto outside = [&](const Vec3& p) {
-      const detail::TwoBoneSolution so = detail::solve_two_bone(limb, shoulder, target.pos_m, p, anatomic);
-      const sim::SwingTwist sw = sim::swing_twist(local_of(so), lim.twist_axis);
-      return sw.swing_rad > lim.swing_max_rad || sw.twist_rad < lim.lower_rad || sw.twist_rad > lim.upper_rad;
-    };
-    if (line.norm() > 1e-6 && outside(pole)) {
-      const Vec3 axis = line.normalized();
-      double found = 0.0;
-      for (int step = 1; step <= kElbowScanSteps && found == 0.0; ++step) {
-        for (const double sign : {1.0, -1.0}) {
-          const double a = sign * step * kElbowScanStep_rad;
-          if (found == 0.0 && !outside(Eigen::AngleAxisd(a, axis) * pole)) found = a;
-        }
-      }
-      if (found != 0.0) {
-        double inside = found, beyond = found - std::copysign(kElbowScanStep_rad, found);
-        for (int it = 0; it < kElbowBisections; ++it) {
-          const double mid = 0.5 * (inside + beyond);
-          (outside(Eigen::AngleAxisd(mid, axis) * pole) ? beyond : inside) = mid;
-        }
-        pole = Eigen::AngleAxisd(inside, axis) * pole;
-        sol = detail::solve_two_bone(limb, shoulder, target.pos_m, pole, anatomic);
-      }
-    }
+    rescue_range(limb, shoulder, target.pos_m, anatomic, w.f.rot[bi(clav)], m.limit[bi(upper)], pole, sol);
     // The smoothed cue remembers the turn the ranges forced (about the line),
     // so the next frame starts from the side they allow rather than crossing
     // back and being turned again (a flailing kick's arm at its twist range).
@@ -606,8 +613,10 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     const double softness = o.leg_softness_m + (procedural ? st.stride_soft_share * o.stride_softness_m : 0.0);
     detail::TwoBoneLimb limb{m.rest_dir[bi(thigh)], m.rest_dir[bi(shank)], m.hinge_axis[bi(shank)],
                              m.thigh_m[s],          m.shank_m[s],          softness};
-    const detail::TwoBoneSolution sol =
-        detail::solve_two_bone(limb, hip[s], target.pos_m, pole, body_yaw * Vec3::UnitX());
+    detail::TwoBoneSolution sol = detail::solve_two_bone(limb, hip[s], target.pos_m, pole, body_yaw * Vec3::UnitX());
+    // A thigh the foot would turn past the hip's range: the knee's plane is
+    // turned into it (as the elbow's), rather than the foot missed (a kick).
+    rescue_range(limb, hip[s], target.pos_m, body_yaw * Vec3::UnitX(), w.f.rot[0], m.limit[bi(thigh)], pole, sol);
     double angle = sol.hinge_rad;
     if (settle_ball(m, w, thigh, sol.upper)) {
       const Vec3 knee = hip[s] + w.f.rot[bi(thigh)] * m.offset[bi(shank)];
