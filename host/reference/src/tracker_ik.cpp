@@ -616,7 +616,18 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     detail::TwoBoneSolution sol = detail::solve_two_bone(limb, hip[s], target.pos_m, pole, body_yaw * Vec3::UnitX());
     // A thigh the foot would turn past the hip's range: the knee's plane is
     // turned into it (as the elbow's), rather than the foot missed (a kick).
+    const Vec3 knee_free = pole;
     rescue_range(limb, hip[s], target.pos_m, body_yaw * Vec3::UnitX(), w.f.rot[0], m.limit[bi(thigh)], pole, sol);
+    {
+      const Vec3 leg = target.pos_m - hip[s];
+      if (leg.norm() > 1e-6) {
+        const Vec3 along = leg.normalized();
+        const Vec3 a = knee_free - knee_free.dot(along) * along, b = pole - pole.dot(along) * along;
+        if (a.norm() > 1e-9 && b.norm() > 1e-9) {
+          st.knee_pole[s] = (sim::quat_from_two_vectors(a.normalized(), b.normalized()) * st.knee_pole[s]).normalized();
+        }
+      }
+    }
     double angle = sol.hinge_rad;
     if (settle_ball(m, w, thigh, sol.upper)) {
       const Vec3 knee = hip[s] + w.f.rot[bi(thigh)] * m.offset[bi(shank)];
