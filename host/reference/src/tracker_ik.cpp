@@ -440,7 +440,7 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     const double raise = smooth_max(0.0, to_hand.normalized().z(), kSoftness);
     const double wanted = std::min(1.0, o.clavicle_share + o.clavicle_raise_share * raise);
     const auto shoulder_at = [&](double kk, Quat& local) {
-      local = Quat(Eigen::AngleAxisd(std::min(kk, cap) * full.angle(), full.axis()));
+      local = Quat(Eigen::AngleAxisd(std::clamp(kk, -cap, cap) * full.angle(), full.axis()));
       return Vec3(clav_pos + chest * (local * m.offset[bi(upper)]));
     };
     // The least share that brings the hand within reach (0 when it is), then
@@ -463,6 +463,25 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     double k = std::min(1.0, smooth_max(wanted, hi, kSoftness));
     if (st.started && k < st.clavicle_share[s]) {
       k = st.clavicle_share[s] + detail::first_order_share(dt, o.clavicle_lower_s) * (k - st.clavicle_share[s]);
+    }
+    // A hand nearer the shoulder than the elbow can fold to: the clavicle
+    // turns away from it (a negative share) until the folded arm reaches it,
+    // rather than toward it, which left the wrist short (a kick's arm pulled
+    // in). At once, as raising is.
+    const sim::JointLimit& fold = m.limit[bi(fore)];
+    if (fold.enabled) {
+      const double flex = std::min(std::numbers::pi, std::max(std::abs(fold.lower_rad), std::abs(fold.upper_rad)));
+      const double a = m.upper_arm_m[s], b = m.forearm_m[s];
+      const double fold_c =
+          std::sqrt(std::max(0.0, a * a + b * b + 2.0 * a * b * std::cos(flex))) + kClavicleReachMargin_m;
+      if ((target.pos_m - shoulder_at(k, clav_local)).norm() < fold_c) {
+        double away = -cap, near = k;  // away: far enough (or as far as the cone allows)
+        for (int it = 0; it < kClavicleBisections; ++it) {
+          const double mid = 0.5 * (away + near);
+          ((target.pos_m - shoulder_at(mid, clav_local)).norm() < fold_c ? near : away) = mid;
+        }
+        k = away;
+      }
     }
     st.clavicle_share[s] = k;
     shoulder_at(k, clav_local);
