@@ -391,6 +391,48 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
   const Vec3 pelvis_now = w.f.pos[0];
   detail::place_bones(m.offset, pelvis_now, w.f);  // trunk joints (limbs are redone below)
 
+  // The chest twists (about its line to the neck joint, which stays put)
+  // toward a hand beyond chest_twist_reach_factor times the arm's reach, by
+  // what brings that shoulder back to it: a kick's flung arm otherwise pulls
+  // the clavicle and elbow to their ends and snaps back. Capped, and smoothed
+  // through two stages (a hand's quick swings are the arm's).
+  {
+    const Vec3 c = w.f.pos[bi(Bone::Chest)];
+    const Vec3 neck_dir = m.offset[bi(Bone::Neck)];
+    const Vec3 axis = neck_dir.norm() > 1e-9 ? Vec3(w.f.rot[bi(Bone::Chest)] * neck_dir.normalized())
+                                             : Vec3(w.f.rot[bi(Bone::Chest)] * Vec3::UnitZ());
+    const auto perp = [&](const Vec3& v) { return Vec3(v - v.dot(axis) * axis); };
+    double wanted = 0.0;
+    for (std::size_t s = 0; s < 2; ++s) {
+      const IkState::Track& tr = st.track[index(kHand[s])];
+      if (!m.calibration.offset[index(kHand[s])].valid || !tr.seen) continue;
+      const Vec3 hand_pos = tr.target.valid ? tr.target.pos_m : tr.shown.pos_m;
+      const Vec3 shoulder = w.f.pos[bi(kClavicle[s])] + w.f.rot[bi(Bone::Chest)] * m.offset[bi(kUpperArm[s])];
+      const double far = o.chest_twist_reach_factor * (m.upper_arm_m[s] + m.forearm_m[s]);
+      if ((hand_pos - shoulder).norm() <= far) continue;
+      const Vec3 p = perp(shoulder - c), h = perp(hand_pos - c);
+      const double r = p.norm(), big_r = h.norm();
+      if (r < 1e-6 || big_r < 1e-6) continue;
+      const double along = (shoulder - hand_pos).dot(axis);
+      const double phi = std::atan2(axis.dot(p.cross(h)), p.dot(h));
+      const double cos_needed = (r * r + big_r * big_r + along * along - far * far) / (2.0 * r * big_r);
+      wanted += cos_needed >= 1.0 ? phi : phi - std::copysign(std::acos(std::max(-1.0, cos_needed)), phi);
+    }
+    wanted = std::clamp(wanted, -o.chest_twist_max_rad, o.chest_twist_max_rad);
+    if (!st.started) st.chest_twist_rad = {wanted, wanted};
+    const double a = detail::first_order_share(dt, o.chest_twist_smoothing_s);
+    st.chest_twist_rad[0] += a * (wanted - st.chest_twist_rad[0]);
+    st.chest_twist_rad[1] += a * (st.chest_twist_rad[0] - st.chest_twist_rad[1]);
+    if (st.chest_twist_rad[1] != 0.0) {
+      const Quat neck_world = w.f.rot[bi(Bone::Neck)];
+      settle_ball(m, w, Bone::Chest,
+                  (Quat(Eigen::AngleAxisd(st.chest_twist_rad[1], axis)) * w.f.rot[bi(Bone::Chest)]).normalized());
+      settle_ball(m, w, Bone::Neck, neck_world);
+      settle_ball(m, w, Bone::Head, head.rot);
+      detail::place_bones(m.offset, pelvis_now, w.f);
+    }
+  }
+
   // Plausibility of the hands against the body.
   const Quat& body_yaw = heading;
   {
