@@ -393,7 +393,7 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
 
   // The chest twists (about its line to the neck joint, which stays put)
   // toward a hand beyond chest_twist_reach_factor times the arm's reach, by
-  // what brings that shoulder back to it: a kick's flung arm otherwise pulls
+  // what brings that shoulder back to the reach: a kick's flung arm otherwise pulls
   // the clavicle and elbow to their ends and snaps back. Capped, and smoothed
   // through two stages (a hand's quick swings are the arm's).
   {
@@ -408,8 +408,11 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
       if (!m.calibration.offset[index(kHand[s])].valid || !tr.seen) continue;
       const Vec3 hand_pos = tr.target.valid ? tr.target.pos_m : tr.shown.pos_m;
       const Vec3 shoulder = w.f.pos[bi(kClavicle[s])] + w.f.rot[bi(Bone::Chest)] * m.offset[bi(kUpperArm[s])];
-      const double far = o.chest_twist_reach_factor * (m.upper_arm_m[s] + m.forearm_m[s]);
-      if ((hand_pos - shoulder).norm() <= far) continue;
+      // Beyond the factor's margin (a hanging arm is about at full reach),
+      // the twist that brings the shoulder back to the arm's reach: the
+      // target steps there, the two stages below make it smooth.
+      const double far = m.upper_arm_m[s] + m.forearm_m[s];
+      if ((hand_pos - shoulder).norm() <= o.chest_twist_reach_factor * far) continue;
       const Vec3 p = perp(shoulder - c), h = perp(hand_pos - c);
       const double r = p.norm(), big_r = h.norm();
       if (r < 1e-6 || big_r < 1e-6) continue;

@@ -64,9 +64,11 @@ struct IkOptions {
   double clavicle_share = 0.08;        // of the swing that would point the clavicle at the hand
   double clavicle_raise_share = 0.25;  // added in proportion to how far above the shoulder the hand is
   double clavicle_lower_s = 0.07;      // a clavicle lowers with this time constant (raises at once; 0: at once)
-  // The chest turns (about the vertical) toward a hand beyond this times the
-  // arm's reach from its shoulder, by what the shoulder needs to come nearer,
-  // at most chest_twist_max_rad, through two first-order stages.
+  // The chest twists (about its line to the neck) toward a hand beyond this
+  // times the arm's reach from its shoulder (a hanging arm is about at full
+  // reach), by what brings the shoulder back to the arm's reach, at most
+  // chest_twist_max_rad, through two first-order stages of
+  // chest_twist_smoothing_s.
   double chest_twist_reach_factor = 1.04;
   double chest_twist_max_rad = 0.8;
   double chest_twist_smoothing_s = 0.07;
