@@ -127,6 +127,51 @@ bool reach_head(const Vec3& base, const Vec3& neck_guess, double neck_m, const V
   return dist <= longest && dist >= shortest;
 }
 
+// A two-bone limb whose upper bone (under `parent`, its parent's world
+// rotation) is past its ball joint's range: the middle joint (elbow, knee) is
+// turned about the root-to-target line until the bone is inside, so the end
+// joint stays on its target. Past its twist, the turn follows the excess
+// almost one to one; past its swing cone (or still past its twist), the
+// nearest place inside both is found by a scan both ways, then bisection onto
+// the boundary (so it moves smoothly). `pole` and `sol` are updated.
+void rescue_range(const detail::TwoBoneLimb& limb, const Vec3& root, const Vec3& target, const Vec3& fallback,
+                  const Quat& parent, const sim::JointLimit& lim, Vec3& pole, detail::TwoBoneSolution& sol) {
+  const Vec3 line = target - root;
+  if (!lim.enabled || line.norm() <= 1e-6) return;
+  const Vec3 axis = line.normalized();
+  const auto local_of = [&](const detail::TwoBoneSolution& so) {
+    return Quat((parent.conjugate() * so.upper).normalized());
+  };
+  for (int it = 0; it < kTwistCorrections; ++it) {
+    const double twist = sim::swing_twist(local_of(sol), lim.twist_axis).twist_rad;
+    const double excess = twist - std::clamp(twist, lim.lower_rad + kTwistMargin_rad, lim.upper_rad - kTwistMargin_rad);
+    if (excess == 0.0) break;
+    pole = Eigen::AngleAxisd(-excess, axis) * pole;
+    sol = detail::solve_two_bone(limb, root, target, pole, fallback);
+  }
+  const auto outside = [&](const Vec3& p) {
+    const detail::TwoBoneSolution so = detail::solve_two_bone(limb, root, target, p, fallback);
+    const sim::SwingTwist sw = sim::swing_twist(local_of(so), lim.twist_axis);
+    return sw.swing_rad > lim.swing_max_rad || sw.twist_rad < lim.lower_rad || sw.twist_rad > lim.upper_rad;
+  };
+  if (!outside(pole)) return;
+  double found = 0.0;
+  for (int step = 1; step <= kElbowScanSteps && found == 0.0; ++step) {
+    for (const double sign : {1.0, -1.0}) {
+      const double a = sign * step * kElbowScanStep_rad;
+      if (found == 0.0 && !outside(Eigen::AngleAxisd(a, axis) * pole)) found = a;
+    }
+  }
+  if (found == 0.0) return;
+  double inside = found, beyond = found - std::copysign(kElbowScanStep_rad, found);
+  for (int it = 0; it < kElbowBisections; ++it) {
+    const double mid = 0.5 * (inside + beyond);
+    (outside(Eigen::AngleAxisd(mid, axis) * pole) ? beyond : inside) = mid;
+  }
+  pole = Eigen::AngleAxisd(inside, axis) * pole;
+  sol = detail::solve_two_bone(limb, root, target, pole, fallback);
+}
+
 }  // namespace
 
 IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calibration, const IkOptions& options) {
@@ -149,7 +194,8 @@ IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calib
                         o.velocity_time_constant_s >= 0.0 && o.landing_follow_s >= 0.0 && o.trunk_smoothing_s >= 0.0 &&
                         o.heading_smoothing_s >= 0.0 && o.waist_heading_smoothing_s >= 0.0 &&
                         o.elbow_smoothing_s >= 0.0 && o.stride_soft_fade_s >= 0.0 && o.knee_smoothing_s >= 0.0 &&
-                        o.tracked_knee_smoothing_s >= 0.0;
+                        o.tracked_knee_smoothing_s >= 0.0 && o.heading_smoothing2_s >= 0.0 &&
+                        o.clavicle_lower_s >= 0.0 && o.chest_twist_smoothing_s >= 0.0;
   const bool sizes_ok = o.step_threshold_m > 0.0 && o.step_turn_rad > 0.0 && o.foot_pivot_start_rad >= 0.0 &&
                         o.foot_pivot_width_rad >= 0.0 && o.step_lift_m >= 0.0 && o.implausible_reach_factor > 1.0 &&
                         o.leg_softness_m >= 0.0 && o.stride_softness_m >= 0.0 && o.stride_soft_speed_mps > 0.0;
@@ -159,7 +205,7 @@ IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calib
                          o.trunk_tilts_with_pelvis <= 1.0 && o.chest_share <= 1.0 && o.neck_share <= 1.0 &&
                          o.hands_heading_weight >= 0.0 && o.neck_back_pole_weight >= 0.0 && o.clavicle_share >= 0.0 &&
                          o.clavicle_raise_share >= 0.0 && o.default_pole_weight >= 0.0 && o.elbow_stay_weight >= 0.0 &&
-                         o.elbow_roll_weight >= 0.0;
+                         o.elbow_roll_weight >= 0.0 && o.chest_twist_reach_factor > 0.0 && o.chest_twist_max_rad >= 0.0;
   if (!(times_ok && sizes_ok && shares_ok)) {
     c.error = "tracker IK: an option is out of range (times and lengths must be positive, shares in [0, 1])";
     return c;
@@ -268,11 +314,22 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
   // The heading smoothed, so the hands' quick swings do not shake the trunk
   // (the head stays exact). 6 points: longer, as it only shapes the trunk
   // the waist tracker carries (a kick's flailing hands turned the chest).
+  // 3 points: two stages, so a quick swing's heading comes in smoothly
+  // rather than with a first-order step's kink (the kicks' flailing hands).
   if (st.started) {
     const bool waist_worn = m.calibration.offset[index(Tracker::waist)].valid;
-    yaw = st.body_yaw_rad +
-          detail::first_order_share(dt, waist_worn ? o.waist_heading_smoothing_s : o.heading_smoothing_s) *
-              std::remainder(yaw - st.body_yaw_rad, 2.0 * std::numbers::pi);
+    const auto follow = [&](double from, double to, double tau) {
+      return from + detail::first_order_share(dt, tau) * std::remainder(to - from, 2.0 * std::numbers::pi);
+    };
+    if (waist_worn) {
+      yaw = follow(st.body_yaw_rad, yaw, o.waist_heading_smoothing_s);
+      st.body_yaw_stage_rad = yaw;
+    } else {
+      st.body_yaw_stage_rad = follow(st.body_yaw_stage_rad, yaw, o.heading_smoothing_s);
+      yaw = follow(st.body_yaw_rad, st.body_yaw_stage_rad, o.heading_smoothing2_s);
+    }
+  } else {
+    st.body_yaw_stage_rad = yaw;
   }
   st.body_yaw_rad = yaw;
   const Quat heading = yaw_quat(yaw);
@@ -334,6 +391,51 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
   const Vec3 pelvis_now = w.f.pos[0];
   detail::place_bones(m.offset, pelvis_now, w.f);  // trunk joints (limbs are redone below)
 
+  // The chest twists (about its line to the neck joint, which stays put)
+  // toward a hand beyond chest_twist_reach_factor times the arm's reach, by
+  // what brings that shoulder back to the reach: a kick's flung arm otherwise pulls
+  // the clavicle and elbow to their ends and snaps back. Capped, and smoothed
+  // through two stages (a hand's quick swings are the arm's).
+  {
+    const Vec3 c = w.f.pos[bi(Bone::Chest)];
+    const Vec3 neck_dir = m.offset[bi(Bone::Neck)];
+    const Vec3 axis = neck_dir.norm() > 1e-9 ? Vec3(w.f.rot[bi(Bone::Chest)] * neck_dir.normalized())
+                                             : Vec3(w.f.rot[bi(Bone::Chest)] * Vec3::UnitZ());
+    const auto perp = [&](const Vec3& v) { return Vec3(v - v.dot(axis) * axis); };
+    double wanted = 0.0;
+    for (std::size_t s = 0; s < 2; ++s) {
+      const IkState::Track& tr = st.track[index(kHand[s])];
+      if (!m.calibration.offset[index(kHand[s])].valid || !tr.seen) continue;
+      const Vec3 hand_pos = tr.target.valid ? tr.target.pos_m : tr.shown.pos_m;
+      const Vec3 shoulder = w.f.pos[bi(kClavicle[s])] + w.f.rot[bi(Bone::Chest)] * m.offset[bi(kUpperArm[s])];
+      // Beyond the factor's margin (a hanging arm is about at full reach),
+      // the twist that brings the shoulder back to the arm's reach: the
+      // target steps there, the two stages below make it smooth.
+      const double far = m.upper_arm_m[s] + m.forearm_m[s];
+      if ((hand_pos - shoulder).norm() <= o.chest_twist_reach_factor * far) continue;
+      const Vec3 p = perp(shoulder - c), h = perp(hand_pos - c);
+      const double r = p.norm(), big_r = h.norm();
+      if (r < 1e-6 || big_r < 1e-6) continue;
+      const double along = (shoulder - hand_pos).dot(axis);
+      const double phi = std::atan2(axis.dot(p.cross(h)), p.dot(h));
+      const double cos_needed = (r * r + big_r * big_r + along * along - far * far) / (2.0 * r * big_r);
+      wanted += cos_needed >= 1.0 ? phi : phi - std::copysign(std::acos(std::max(-1.0, cos_needed)), phi);
+    }
+    wanted = std::clamp(wanted, -o.chest_twist_max_rad, o.chest_twist_max_rad);
+    if (!st.started) st.chest_twist_rad = {wanted, wanted};
+    const double a = detail::first_order_share(dt, o.chest_twist_smoothing_s);
+    st.chest_twist_rad[0] += a * (wanted - st.chest_twist_rad[0]);
+    st.chest_twist_rad[1] += a * (st.chest_twist_rad[0] - st.chest_twist_rad[1]);
+    if (st.chest_twist_rad[1] != 0.0) {
+      const Quat neck_world = w.f.rot[bi(Bone::Neck)];
+      settle_ball(m, w, Bone::Chest,
+                  (Quat(Eigen::AngleAxisd(st.chest_twist_rad[1], axis)) * w.f.rot[bi(Bone::Chest)]).normalized());
+      settle_ball(m, w, Bone::Neck, neck_world);
+      settle_ball(m, w, Bone::Head, head.rot);
+      detail::place_bones(m.offset, pelvis_now, w.f);
+    }
+  }
+
   // Plausibility of the hands against the body.
   const Quat& body_yaw = heading;
   {
@@ -383,7 +485,7 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     const double raise = smooth_max(0.0, to_hand.normalized().z(), kSoftness);
     const double wanted = std::min(1.0, o.clavicle_share + o.clavicle_raise_share * raise);
     const auto shoulder_at = [&](double kk, Quat& local) {
-      local = Quat(Eigen::AngleAxisd(std::min(kk, cap) * full.angle(), full.axis()));
+      local = Quat(Eigen::AngleAxisd(std::clamp(kk, -cap, cap) * full.angle(), full.axis()));
       return Vec3(clav_pos + chest * (local * m.offset[bi(upper)]));
     };
     // The least share that brings the hand within reach (0 when it is), then
@@ -400,7 +502,33 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
       const double mid = 0.5 * (lo + hi);
       ((target.pos_m - shoulder_at(mid, clav_local)).norm() > reach_c ? lo : hi) = mid;
     }
-    const double k = std::min(1.0, smooth_max(wanted, hi, kSoftness));
+    // Raised at once, lowered over clavicle_lower_s: a shoulder that dropped
+    // as soon as the reach allowed snapped back (a kick's flung arm). Higher
+    // than the reach needs is still within it.
+    double k = std::min(1.0, smooth_max(wanted, hi, kSoftness));
+    if (st.started && k < st.clavicle_share[s]) {
+      k = st.clavicle_share[s] + detail::first_order_share(dt, o.clavicle_lower_s) * (k - st.clavicle_share[s]);
+    }
+    // A hand nearer the shoulder than the elbow can fold to: the clavicle
+    // turns away from it (a negative share) until the folded arm reaches it,
+    // rather than toward it, which left the wrist short (a kick's arm pulled
+    // in). At once, as raising is.
+    const sim::JointLimit& fold = m.limit[bi(fore)];
+    if (fold.enabled) {
+      const double flex = std::min(std::numbers::pi, std::max(std::abs(fold.lower_rad), std::abs(fold.upper_rad)));
+      const double a = m.upper_arm_m[s], b = m.forearm_m[s];
+      const double fold_c =
+          std::sqrt(std::max(0.0, a * a + b * b + 2.0 * a * b * std::cos(flex))) + kClavicleReachMargin_m;
+      if ((target.pos_m - shoulder_at(k, clav_local)).norm() < fold_c) {
+        double away = -cap, near = k;  // away: far enough (or as far as the cone allows)
+        for (int it = 0; it < kClavicleBisections; ++it) {
+          const double mid = 0.5 * (away + near);
+          ((target.pos_m - shoulder_at(mid, clav_local)).norm() < fold_c ? near : away) = mid;
+        }
+        k = away;
+      }
+    }
+    st.clavicle_share[s] = k;
     shoulder_at(k, clav_local);
     settle_ball(m, w, clav, (chest * clav_local).normalized());
     const Vec3 shoulder = joint_of(w, m, upper);
@@ -457,45 +585,7 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     const Vec3 pole_free = pole;  // before the ranges turn it
     // An elbow the upper arm cannot twist to is turned about the shoulder-wrist
     // line until it can (the twist follows that turn almost one to one).
-    const sim::JointLimit& lim = m.limit[bi(upper)];
-    const auto local_of = [&](const detail::TwoBoneSolution& so) {
-      return Quat((w.f.rot[bi(clav)].conjugate() * so.upper).normalized());
-    };
-    for (int it = 0; it < kTwistCorrections && line.norm() > 1e-6; ++it) {
-      const double twist = sim::swing_twist(local_of(sol), lim.twist_axis).twist_rad;
-      const double excess =
-          twist - std::clamp(twist, lim.lower_rad + kTwistMargin_rad, lim.upper_rad - kTwistMargin_rad);
-      if (excess == 0.0) break;
-      pole = Eigen::AngleAxisd(-excess, line.normalized()) * pole;
-      sol = detail::solve_two_bone(limb, shoulder, target.pos_m, pole, anatomic);
-    }
-    // An upper arm past its swing cone (or still past its twist): the elbow
-    // is turned about the line to the nearest place inside both, found by a
-    // scan both ways, then bisection onto the boundary (so it moves smoothly).
-    const auto outside = [&](const Vec3& p) {
-      const detail::TwoBoneSolution so = detail::solve_two_bone(limb, shoulder, target.pos_m, p, anatomic);
-      const sim::SwingTwist sw = sim::swing_twist(local_of(so), lim.twist_axis);
-      return sw.swing_rad > lim.swing_max_rad || sw.twist_rad < lim.lower_rad || sw.twist_rad > lim.upper_rad;
-    };
-    if (line.norm() > 1e-6 && outside(pole)) {
-      const Vec3 axis = line.normalized();
-      double found = 0.0;
-      for (int step = 1; step <= kElbowScanSteps && found == 0.0; ++step) {
-        for (const double sign : {1.0, -1.0}) {
-          const double a = sign * step * kElbowScanStep_rad;
-          if (found == 0.0 && !outside(Eigen::AngleAxisd(a, axis) * pole)) found = a;
-        }
-      }
-      if (found != 0.0) {
-        double inside = found, beyond = found - std::copysign(kElbowScanStep_rad, found);
-        for (int it = 0; it < kElbowBisections; ++it) {
-          const double mid = 0.5 * (inside + beyond);
-          (outside(Eigen::AngleAxisd(mid, axis) * pole) ? beyond : inside) = mid;
-        }
-        pole = Eigen::AngleAxisd(inside, axis) * pole;
-        sol = detail::solve_two_bone(limb, shoulder, target.pos_m, pole, anatomic);
-      }
-    }
+    rescue_range(limb, shoulder, target.pos_m, anatomic, w.f.rot[bi(clav)], m.limit[bi(upper)], pole, sol);
     // The smoothed cue remembers the turn the ranges forced (about the line),
     // so the next frame starts from the side they allow rather than crossing
     // back and being turned again (a flailing kick's arm at its twist range).
@@ -587,8 +677,21 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     const double softness = o.leg_softness_m + (procedural ? st.stride_soft_share * o.stride_softness_m : 0.0);
     detail::TwoBoneLimb limb{m.rest_dir[bi(thigh)], m.rest_dir[bi(shank)], m.hinge_axis[bi(shank)],
                              m.thigh_m[s],          m.shank_m[s],          softness};
-    const detail::TwoBoneSolution sol =
-        detail::solve_two_bone(limb, hip[s], target.pos_m, pole, body_yaw * Vec3::UnitX());
+    detail::TwoBoneSolution sol = detail::solve_two_bone(limb, hip[s], target.pos_m, pole, body_yaw * Vec3::UnitX());
+    // A thigh the foot would turn past the hip's range: the knee's plane is
+    // turned into it (as the elbow's), rather than the foot missed (a kick).
+    const Vec3 knee_free = pole;
+    rescue_range(limb, hip[s], target.pos_m, body_yaw * Vec3::UnitX(), w.f.rot[0], m.limit[bi(thigh)], pole, sol);
+    {
+      const Vec3 leg = target.pos_m - hip[s];
+      if (leg.norm() > 1e-6) {
+        const Vec3 along = leg.normalized();
+        const Vec3 a = knee_free - knee_free.dot(along) * along, b = pole - pole.dot(along) * along;
+        if (a.norm() > 1e-9 && b.norm() > 1e-9) {
+          st.knee_pole[s] = (sim::quat_from_two_vectors(a.normalized(), b.normalized()) * st.knee_pole[s]).normalized();
+        }
+      }
+    }
     double angle = sol.hinge_rad;
     if (settle_ball(m, w, thigh, sol.upper)) {
       const Vec3 knee = hip[s] + w.f.rot[bi(thigh)] * m.offset[bi(shank)];

@@ -48,7 +48,8 @@ struct IkOptions {
   double chest_share = 0.25;
   double neck_share = 0.6;
   double hands_heading_weight = 0.3;        // the hands' say in the body's heading, against the head's 1
-  double heading_smoothing_s = 0.02;        // time constant of that heading, 3 points (0: none)
+  double heading_smoothing_s = 0.02;        // time constant of that heading, 3 points (0: none) ...
+  double heading_smoothing2_s = 0.02;       // ... then of a second stage after it (3 points only; 0: none)
   double waist_heading_smoothing_s = 0.05;  // ... and 6 points (it only shapes the trunk the waist carries)
   double trunk_smoothing_s = 0.05;          // time constant of the head turn the trunk bones share (0: none)
   double trunk_follows_pelvis = 0.5;        // 6 points: the share of the waist tracker's turn (about the vertical) the
@@ -62,11 +63,20 @@ struct IkOptions {
   // Arms.
   double clavicle_share = 0.08;        // of the swing that would point the clavicle at the hand
   double clavicle_raise_share = 0.25;  // added in proportion to how far above the shoulder the hand is
-  double default_pole_weight = 0.25;   // elbows: the anatomical pole (down, back) against the hand's
-  double elbow_stay_weight = 3.0;      // a bent arm's elbow kept on its last side, against the smoothed cue's 1
-  double elbow_roll_weight = 0.5;      // elbows: the hand's roll (the elbow's axis, least wrist twist) against it
-  double arm_softness_m = 0.002;       // soft reach near a straight arm (the wrist short by at most 0.37 of it)
-  double leg_softness_m = 0.0;         // ... and leg, always (0: a standing leg straight, its foot on the floor)
+  double clavicle_lower_s = 0.07;      // a clavicle lowers with this time constant (raises at once; 0: at once)
+  // The chest twists (about its line to the neck) toward a hand beyond this
+  // times the arm's reach from its shoulder (a hanging arm is about at full
+  // reach), by what brings the shoulder back to the arm's reach, at most
+  // chest_twist_max_rad, through two first-order stages of
+  // chest_twist_smoothing_s.
+  double chest_twist_reach_factor = 1.04;
+  double chest_twist_max_rad = 0.8;
+  double chest_twist_smoothing_s = 0.07;
+  double default_pole_weight = 0.25;  // elbows: the anatomical pole (down, back) against the hand's
+  double elbow_stay_weight = 3.0;     // a bent arm's elbow kept on its last side, against the smoothed cue's 1
+  double elbow_roll_weight = 0.5;     // elbows: the hand's roll (the elbow's axis, least wrist twist) against it
+  double arm_softness_m = 0.002;      // soft reach near a straight arm (the wrist short by at most 0.37 of it)
+  double leg_softness_m = 0.0;        // ... and leg, always (0: a standing leg straight, its foot on the floor)
   // Procedural feet (3 points) only: a soft reach that fades in with the
   // pelvis's horizontal speed, full at stride_soft_speed_mps. Near a straight
   // leg the knee moves as the square root of the slack, so a walking pelvis
@@ -196,6 +206,9 @@ struct IkState {
   };
   std::array<Track, kTrackerCount> track{};
   double body_yaw_rad = 0.0;
+  double body_yaw_stage_rad = 0.0;               // the heading's first smoothing stage (3 points)
+  std::array<double, 2> clavicle_share{};        // the clavicles' last share of their turn (eased down)
+  std::array<double, 2> chest_twist_rad{};       // the chest's twist toward a far hand: stage 1, stage 2
   sim::Quat trunk_turn = sim::Quat::Identity();  // the head's turn from the heading, smoothed
   std::array<sim::Vec3, 2> elbow_pole{};         // in the chest's frame, smoothed, unit
   std::array<sim::Vec3, 2> elbow_last{};         // the last solved upper arm's direction, chest's frame
