@@ -60,7 +60,7 @@ TEST_CASE("tonus ik: walks from 3 and 6 trackers meet the goals") {
   }
 }
 
-TEST_CASE("tonus ik: no jerkier than the clip on every shared clip but the kicks" *
+TEST_CASE("tonus ik: no jerkier than the clip on every shared clip but the kicks from 6 points" *
           tonus::test::heavy_under_sanitizers()) {
   // The goal, jitter no higher than the source's, on the shared
   // clips from 3 and 6 trackers (docs/reference.md). Met on 13 runs of 14
