@@ -4,7 +4,9 @@
 
 #include <sys/socket.h>
 
+#include <cstdint>
 #include <filesystem>
+#include <string>
 
 #include "sim_process.hpp"
 #include "support/read_file.hpp"
@@ -46,7 +48,13 @@ struct StreamCheck {
 }  // namespace
 
 TEST_CASE("HID link: continuous stream, device timestamps, command round trips, bad input") {
-  test::SimProcess sim({"--synthetic", "ramp", "--seconds", "3", "--fast", "--quiet", "--hid-fd", "3"});
+  // 20 s of stream, not 3: with --fast the band blocks on a full socket, and
+  // each command's response waits behind what the socket holds (hundreds of
+  // reports), so on a loaded machine 3 s ran out before the eighth command
+  // (6 failures in 40 runs beside three busy loops; none with 20 s).
+  constexpr std::uint32_t kSeconds = 20;
+  test::SimProcess sim(
+      {"--synthetic", "ramp", "--seconds", std::to_string(kSeconds), "--fast", "--quiet", "--hid-fd", "3"});
   REQUIRE(sim.started());
   host::SeqpacketHidTransport transport(sim.take_hid());
   host::HidBandLink link(transport);
@@ -127,7 +135,7 @@ TEST_CASE("HID link: continuous stream, device timestamps, command round trips, 
   REQUIRE(rsp.has_value());
   CHECK(rsp->status == proto::Status::ok);
 
-  // Drain to the end: the simulator exits when its 3 s are done.
+  // Drain to the end: the simulator exits when its kSeconds are done.
   host::LinkEvent e;
   do {
     e = link.poll(3000);
@@ -136,8 +144,8 @@ TEST_CASE("HID link: continuous stream, device timestamps, command round trips, 
   CHECK(e.kind == host::LinkEvent::Kind::closed);
   CHECK(stream.gaps == 0);
   CHECK(stream.last_step == 2 * period_us);
-  CHECK(stream.count > 3 * info.report_rate_hz / 2);  // 3 s, part at the full rate, part at half
-  CHECK(stream.count < 3 * info.report_rate_hz);
+  CHECK(stream.count > kSeconds * info.report_rate_hz / 2);  // part at the full rate, part at half
+  CHECK(stream.count < kSeconds * info.report_rate_hz);
   CHECK(link.decode_errors() == 0);
   CHECK(sim.wait(5s) == 0);
 }
