@@ -19,6 +19,19 @@ namespace {
 
 using namespace tonus;
 
+// One solve of the clip's frame f at time t_s, timed on its own: seconds.
+double timed_solve(const experiments::IkSetup& setup, reference::IkState& ik_state, reference::IkOutput& out,
+                   std::size_t f, double t_s) {
+  reference::TrackerFrame frame = setup.trackers[f];
+  frame.time_s = t_s;
+  const auto t0 = std::chrono::steady_clock::now();
+  reference::solve_ik(*setup.ik, ik_state, frame, out);
+  benchmark::DoNotOptimize(out.qpos.data());
+  benchmark::ClobberMemory();
+  const auto t1 = std::chrono::steady_clock::now();
+  return std::chrono::duration<double>(t1 - t0).count();
+}
+
 // The clip's slowest frame by the median of its solves over repeated passes:
 // whether a tail above the goal is a frame the solver finds hard (this figure
 // above it too) or the machine interrupting solves at random (this figure low).
@@ -31,14 +44,7 @@ double slowest_frame_median_us(const experiments::IkSetup& setup) {
   double t = 0.0;
   for (std::size_t pass = 0; pass < kPasses; ++pass) {
     for (std::size_t f = 0; f < n; ++f) {
-      reference::TrackerFrame frame = setup.trackers[f];
-      frame.time_s = t;
-      const auto t0 = std::chrono::steady_clock::now();
-      reference::solve_ik(*setup.ik, ik_state, frame, out);
-      benchmark::DoNotOptimize(out.qpos.data());
-      benchmark::ClobberMemory();
-      const auto t1 = std::chrono::steady_clock::now();
-      us[f * kPasses + pass] = 1e6 * std::chrono::duration<double>(t1 - t0).count();
+      us[f * kPasses + pass] = 1e6 * timed_solve(setup, ik_state, out, f, t);
       t += setup.dt_s;
     }
   }
@@ -74,14 +80,7 @@ void solve(benchmark::State& state, const std::string& clip, int trackers) {
   std::vector<double> us;
   us.reserve(1 << 22);
   for (auto _ : state) {  // NOLINT(clang-analyzer-deadcode.DeadStores): Google Benchmark's loop idiom
-    reference::TrackerFrame frame = setup.trackers[f];
-    frame.time_s = t;
-    const auto t0 = std::chrono::steady_clock::now();
-    reference::solve_ik(*setup.ik, ik_state, frame, out);
-    benchmark::DoNotOptimize(out.qpos.data());
-    benchmark::ClobberMemory();
-    const auto t1 = std::chrono::steady_clock::now();
-    const double s = std::chrono::duration<double>(t1 - t0).count();
+    const double s = timed_solve(setup, ik_state, out, f, t);
     state.SetIterationTime(s);
     if (us.size() < us.capacity()) us.push_back(1e6 * s);
     f = (f + 1) % setup.trackers.size();
