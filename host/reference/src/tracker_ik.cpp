@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "body_frames.hpp"
 #include "first_order.hpp"
@@ -170,6 +171,15 @@ void rescue_range(const detail::TwoBoneLimb& limb, const Vec3& root, const Vec3&
   }
   pole = Eigen::AngleAxisd(inside, axis) * pole;
   sol = detail::solve_two_bone(limb, root, target, pole, fallback);
+}
+
+// The turn about the unit `along` that takes where `before` points across it
+// to where `after` does (none when either lies along it): what a range
+// rescue did to a pole, for the smoothed pole to remember.
+std::optional<Quat> turn_across(const Vec3& before, const Vec3& after, const Vec3& along) {
+  const Vec3 a = before - before.dot(along) * along, b = after - after.dot(along) * along;
+  if (a.norm() <= 1e-9 || b.norm() <= 1e-9) return std::nullopt;
+  return sim::quat_from_two_vectors(a.normalized(), b.normalized());
 }
 
 }  // namespace
@@ -589,10 +599,8 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     // The smoothed cue remembers the turn the ranges forced (about the line),
     // so the next frame starts from the side they allow rather than crossing
     // back and being turned again (a flailing kick's arm at its twist range).
-    const Vec3 free_across = across_line(pole_free), used_across = across_line(pole);
-    if (free_across.norm() > 1e-9 && used_across.norm() > 1e-9) {
-      const Quat turned = sim::quat_from_two_vectors(free_across.normalized(), used_across.normalized());
-      st.elbow_pole[s] = (chest.conjugate() * (turned * (chest * st.elbow_pole[s]))).normalized();
+    if (const std::optional<Quat> turned = turn_across(pole_free, pole, along)) {
+      st.elbow_pole[s] = (chest.conjugate() * (*turned * (chest * st.elbow_pole[s]))).normalized();
     }
     st.elbow_last[s] = chest.conjugate() * (sol.upper * m.rest_dir[bi(upper)]);
     w.f.pos[bi(upper)] = shoulder;
@@ -682,15 +690,10 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     // turned into it (as the elbow's), rather than the foot missed (a kick).
     const Vec3 knee_free = pole;
     rescue_range(limb, hip[s], target.pos_m, body_yaw * Vec3::UnitX(), w.f.rot[0], m.limit[bi(thigh)], pole, sol);
-    {
-      const Vec3 leg = target.pos_m - hip[s];
-      if (leg.norm() > 1e-6) {
-        const Vec3 along = leg.normalized();
-        const Vec3 a = knee_free - knee_free.dot(along) * along, b = pole - pole.dot(along) * along;
-        if (a.norm() > 1e-9 && b.norm() > 1e-9) {
-          st.knee_pole[s] = (sim::quat_from_two_vectors(a.normalized(), b.normalized()) * st.knee_pole[s]).normalized();
-        }
-      }
+    const Vec3 leg = target.pos_m - hip[s];
+    if (const std::optional<Quat> turned =
+            leg.norm() > 1e-6 ? turn_across(knee_free, pole, leg.normalized()) : std::nullopt) {
+      st.knee_pole[s] = (*turned * st.knee_pole[s]).normalized();
     }
     double angle = sol.hinge_rad;
     if (settle_ball(m, w, thigh, sol.upper)) {
