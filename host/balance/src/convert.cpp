@@ -18,6 +18,9 @@ constexpr double kTypicalLegM = 0.85;  // hip to ankle joint centre of an adult
 
 double de_leva_len(Segment s) { return sim::de_leva(s, sim::Sex::male).length_m; }
 
+// Winter: foot 0.152 H, hip to ankle 0.491 H.
+double foot_length_m(double thigh_m, double shank_m) { return 0.152 / (0.530 - 0.039) * (thigh_m + shank_m); }
+
 struct Unit {
   const char* name;
   double metres;
@@ -79,20 +82,15 @@ Quat file_to_internal() {
   return Quat(c);
 }
 
-void landmarks_from_poses(const SkeletonGeometry& g, const std::vector<motion::JointPose>& poses, MotionFrame& out) {
-  const Quat c = file_to_internal();
-  const double s = g.metres_per_unit;
-  const auto pos = [&](int j) { return Vec3(s * to_internal(poses[static_cast<std::size_t>(j)].position)); };
+namespace {
+
+// The landmarks a skeleton lacks, from the bones it has (`have`; their joint
+// positions and rotations already in `out`). `pos` gives a file joint's
+// position (internal frame, metres): the End Sites `g` names.
+template <class JointPosition>
+void synthesise_landmarks(const SkeletonGeometry& g, const std::array<bool, sim::kBoneCount>& have,
+                          const JointPosition& pos, MotionFrame& out) {
   auto& p = out.p;
-  std::array<bool, sim::kBoneCount> have{};
-  for (std::size_t b = 0; b < sim::kBoneCount; ++b) {
-    const int j = g.map.joint[b];
-    have[b] = j >= 0;
-    if (j >= 0) {
-      p[b] = pos(j);
-      out.rotation[b] = c * poses[static_cast<std::size_t>(j)].rotation * c.conjugate();
-    }
-  }
   const auto P = [&](Bone b) -> Vec3& { return p[sim::index(b)]; };
   const auto R = [&](Bone b) -> Quat& { return out.rotation[sim::index(b)]; };
   p[index(Landmark::MidHip)] = 0.5 * (P(Bone::LeftUpperLeg) + P(Bone::RightUpperLeg));
@@ -173,6 +171,45 @@ void landmarks_from_poses(const SkeletonGeometry& g, const std::vector<motion::J
   }
 }
 
+}  // namespace
+
+void landmarks_from_poses(const SkeletonGeometry& g, const std::vector<motion::JointPose>& poses, MotionFrame& out) {
+  const Quat c = file_to_internal();
+  const double s = g.metres_per_unit;
+  const auto pos = [&](int j) { return Vec3(s * to_internal(poses[static_cast<std::size_t>(j)].position)); };
+  std::array<bool, sim::kBoneCount> have{};
+  for (std::size_t b = 0; b < sim::kBoneCount; ++b) {
+    const int j = g.map.joint[b];
+    have[b] = j >= 0;
+    if (j >= 0) {
+      out.p[b] = pos(j);
+      out.rotation[b] = c * poses[static_cast<std::size_t>(j)].rotation * c.conjugate();
+    }
+  }
+  synthesise_landmarks(g, have, pos, out);
+}
+
+SkeletonGeometry geometry_from_lengths(double thigh_m, double shank_m, double forearm_m) {
+  SkeletonGeometry g;
+  g.map.joint.fill(-1);
+  g.thigh_m = thigh_m;
+  g.shank_m = shank_m;
+  g.forearm_m = forearm_m;
+  g.foot_m = foot_length_m(thigh_m, shank_m);
+  return g;
+}
+
+void landmarks_from_bones(const SkeletonGeometry& g, const std::array<bool, sim::kBoneCount>& have,
+                          MotionFrame& frame) {
+  // No End Site is named (geometry_from_lengths), so no file joint is asked for.
+  const auto none = [&](int) { return Vec3(Vec3::Zero()); };
+  SkeletonGeometry bare = g;
+  bare.head_top_joint = -1;
+  bare.hand_far_joint[0] = bare.hand_far_joint[1] = -1;
+  bare.toe_tip_joint[0] = bare.toe_tip_joint[1] = -1;
+  synthesise_landmarks(bare, have, none, frame);
+}
+
 Conversion convert_motion(const motion::Clip& clip, const MapResult& mapping, const ConvertOptions& opt) {
   Conversion r;
   if (!mapping.ok()) {
@@ -235,7 +272,7 @@ Conversion convert_motion(const motion::Clip& clip, const MapResult& mapping, co
   g.thigh_m = thigh * s;
   g.shank_m = shank * s;
   g.forearm_m = forearm * s;
-  g.foot_m = 0.152 / (0.530 - 0.039) * (g.thigh_m + g.shank_m);  // Winter: foot 0.152 H, hip to ankle 0.491 H
+  g.foot_m = foot_length_m(g.thigh_m, g.shank_m);
   const int head =
       joint_of_bone(g.map, Bone::Head) >= 0 ? joint_of_bone(g.map, Bone::Head) : joint_of_bone(g.map, Bone::Neck);
   g.head_top_joint = real_end_site(clip, head, 0.02 / s);

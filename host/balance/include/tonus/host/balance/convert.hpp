@@ -5,6 +5,7 @@
 // leading T-pose frame detected and excluded.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -48,6 +49,17 @@ Conversion convert_motion(const motion::Clip& clip, const MapResult& mapping, co
 
 // One frame's landmarks and bone rotations from its poses (file frame).
 void landmarks_from_poses(const SkeletonGeometry& g, const std::vector<motion::JointPose>& poses, MotionFrame& out);
+
+// A streamed skeleton's geometry (no BVH file: joint positions only, no End
+// Sites): the thigh, shank and forearm lengths (m) from which landmarks_from_bones
+// synthesises the extremities, as convert_motion does for a file without them.
+SkeletonGeometry geometry_from_lengths(double thigh_m, double shank_m, double forearm_m);
+
+// One frame's landmarks from its bones: `frame` holds the joint position and
+// world rotation (internal frame, metres) of each bone `have` names; the rest
+// (missing spine joints, shoulders, neck or head, head top, hand and toe tips,
+// heels, mid-hip) are synthesised as for a BVH frame. `g`'s End Sites are not used.
+void landmarks_from_bones(const SkeletonGeometry& g, const std::array<bool, sim::kBoneCount>& have, MotionFrame& frame);
 
 // The fixed change of axes between the file (Y up) and the internal frame (Z up).
 Quat file_to_internal();
