@@ -55,9 +55,10 @@ TEST_CASE("config: a bad value names the key and the value, and nothing is accep
       {"[tracker]\ndelay_ms = 5000\n", "tracker.delay_ms = 5000"},
       {"[tracker]\nbalance = \"on\"\n", "tracker.balance = \"on\": must be one of off, offline, online"},
       {"[tracker]\nbalance_lookahead_ms = 400\n", "tracker.balance_lookahead_ms = 400: must be 1..250"},
-      {"[tracker]\nsource = \"vmc\"\nbalance = \"online\"\n",
-       "tracker.balance = \"online\": the balance filter runs "
-       "on a bvh source only"},
+      {"[tracker]\nsource = \"vmc\"\nvmc_mode = \"trackers\"\nbalance = \"online\"\n",
+       "tracker.balance = \"online\": the balance filter runs on a bvh source or a VMC performer stream"},
+      {"[tracker]\nsource = \"vmc\"\nbalance = \"offline\"\n",
+       "tracker.balance = \"offline\": the offline filter needs a whole clip"},
       {"[log]\nlevel = \"loud\"\n", "log.level = \"loud\""},
       {"[demo]\ngifts = [ { at_s = 1, kind = \"piano\", bone = \"Head\" } ]\n", "demo.gifts[0].kind = \"piano\""},
       {"[demo]\ngifts = [ { at_s = 1, kind = \"ball\", bone = \"Tail\" } ]\n", "demo.gifts[0].bone = \"Tail\""},
@@ -101,6 +102,9 @@ TEST_CASE("config: keys read over the defaults, the printed config reads back to
               .empty());
   CHECK(c.tracker.balance == tonus::balance::BalanceMode::online);
   CHECK(c.tracker.balance_lookahead_s == doctest::Approx(0.1));
+  DaemonConfig live;
+  REQUIRE(parse_config("[tracker]\nsource = \"vmc\"\nbalance = \"online\"\n", "v.toml", live).empty());
+  CHECK(live.tracker.balance == tonus::balance::BalanceMode::online);  // a live performer: online only
 
   const std::string printed = to_toml(c);
   DaemonConfig back;

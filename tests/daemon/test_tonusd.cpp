@@ -301,6 +301,94 @@ TEST_CASE("tonusd: a VMC performer's stream is followed, held when it stops, eas
   CHECK(j["tracker_vmc_ignored"].get<int>() >= 3);
 }
 
+TEST_CASE("tonusd: a VMC performer's stream through the online balance filter comes the look-ahead later") {
+  VmcCapture capture;
+  const std::string json = temp_path("performer-balance.json");
+  Process d(TONUSD,
+            {"--no-realtime",
+             "--seconds",
+             "5",
+             "--band",
+             "none",
+             "--tracker",
+             "vmc",
+             "--vmc-mode",
+             "performer",
+             "--balance",
+             "online",
+             "--listen-port",
+             "0",
+             "--vmc-port",
+             std::to_string(capture.port()),
+             "--vmc-rate",
+             "100",
+             "--no-control",
+             "--no-viewer",
+             "--json",
+             json},
+            temp_path("performer-balance.log"));
+  REQUIRE(d.started());
+  const int listen_port = port_in_log(d, "mode on 127\\.0\\.0\\.1:([0-9]+)");
+  REQUIRE(listen_port > 0);
+
+  // The performer stands (the humanoid's rest: balanced, so nothing to
+  // correct), then raises the left arm 0.8 rad and holds it.
+  const sim::Model& model = test::daemon_humanoid();
+  std::array<double, sim::kMaxQpos> raised = model.qpos0;
+  const auto arm = static_cast<std::size_t>(model.bodies[sim::index(sim::Bone::LeftUpperArm)].qpos_adr);
+  const sim::Quat up(Eigen::AngleAxisd(0.8, sim::Vec3::UnitX()));
+  raised[arm] = up.w();
+  raised[arm + 1] = up.x();
+  raised[arm + 2] = up.y();
+  raised[arm + 3] = up.z();
+  vmc::VmcPose standing, lifted;
+  REQUIRE(vmc::pose_from_qpos(model, model.qpos0, standing));
+  REQUIRE(vmc::pose_from_qpos(model, raised, lifted));
+  vmc::SenderOptions so;
+  so.port = listen_port;
+  vmc::VmcSender sender(so);
+  REQUIRE(sender.ok());
+  std::int64_t lift_us = 0;
+  for (int k = 0; k < 180; ++k) {  // 1.5 s standing, 1.5 s raised, at 60 Hz
+    if (k == 90) lift_us = test::steady_us();
+    sender.send(k < 90 ? standing : lifted, k / 60.0, {}, nullptr);
+    std::this_thread::sleep_for(std::chrono::microseconds(16667));
+  }
+  REQUIRE(d.wait(std::chrono::seconds(30)) == 0);
+  INFO(d.output());
+
+  // The arm rises once the filter's look-ahead (250 ms, the default) has
+  // passed; the stream's own path (the jitter buffer's 30 ms and the
+  // physics) takes under 100 ms without the stage.
+  const auto rot = [](const sim::Quat& q) { return std::array<double, 4>{q.x(), q.y(), q.z(), q.w()}; };
+  const std::array<double, 4> want = rot(lifted.bone[sim::index(sim::Bone::LeftUpperArm)].rot);
+  std::int64_t risen_us = -1;
+  double held_err = 0.0;
+  int held_n = 0;
+  for (const auto& m : capture.messages()) {
+    if (m.path != "/VMC/Ext/Bone/Pos" || m.text != "LeftUpperArm" || m.arrival_us < lift_us) continue;
+    const double err = angle_between({m.numbers[3], m.numbers[4], m.numbers[5], m.numbers[6]}, want);
+    if (risen_us < 0 && err < 0.4) risen_us = m.arrival_us;
+    if (m.arrival_us > lift_us + 800'000 && m.arrival_us < lift_us + 1'400'000) {
+      held_err = std::max(held_err, err);
+      ++held_n;
+    }
+  }
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  const std::string note = j["tracker_balance"].get<std::string>();
+  MESSAGE("balance: " << note << "; the arm half-way up " << (risen_us - lift_us) / 1000
+                      << " ms after the performer's; then off it by at most " << held_err << " rad");
+  CHECK(note.find("online on the VMC performer stream") != std::string::npos);
+  CHECK(std::regex_search(note, std::regex("the sender at (5[5-9]|6[0-5])\\.[0-9] Hz")));
+  CHECK(note.find("look-ahead 15 frames") != std::string::npos);
+  REQUIRE(risen_us > 0);
+  CHECK(risen_us - lift_us >= 230'000);
+  CHECK(risen_us - lift_us < 600'000);
+  REQUIRE(held_n > 10);
+  CHECK(held_err < 0.1);  // the stage does not touch the arms
+}
+
 TEST_CASE("tonusd: the control API spawns gifts, overrides and releases the stiffness, reports status, tonus ctl too") {
   VmcCapture capture;
   Process d(TONUSD,

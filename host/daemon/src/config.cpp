@@ -64,10 +64,20 @@ std::string validate(const DaemonConfig& c) {
   const TrackerConfig& t = c.tracker;
   if (std::string e = validate_port("tracker.listen_port", t.listen_port, true); !e.empty()) return e;
   if (t.listen_address.empty()) return "tracker.listen_address = \"\": an address is needed";
-  if (t.balance != balance::BalanceMode::off && t.source != TrackerSource::bvh) {
+  // A clip is corrected offline or online; a live VMC performer's stream only
+  // online (there is no whole clip); the tracker IK's legs are its own.
+  const bool live_performer = t.source == TrackerSource::vmc && t.vmc_mode == VmcMode::performer;
+  if (t.balance == balance::BalanceMode::online && t.source != TrackerSource::bvh && !live_performer) {
     return fmt::format(
-        "tracker.balance = \"{}\": the balance filter runs on a bvh source only (tracker.source = \"{}\")",
-        balance::to_string(t.balance), to_string(t.source));
+        "tracker.balance = \"online\": the balance filter runs on a bvh source or a VMC performer stream "
+        "(tracker.source = \"{}\", tracker.vmc_mode = \"{}\")",
+        to_string(t.source), to_string(t.vmc_mode));
+  }
+  if (t.balance == balance::BalanceMode::offline && t.source != TrackerSource::bvh) {
+    return fmt::format(
+        "tracker.balance = \"offline\": the offline filter needs a whole clip (tracker.source = \"bvh\"); a live "
+        "VMC performer stream takes \"online\" (tracker.source = \"{}\")",
+        to_string(t.source));
   }
   if (!in(t.balance_lookahead_s, 0.001, balance::kMaxLookahead_s)) {
     return bad("tracker.balance_lookahead_ms", t.balance_lookahead_s * 1e3, "must be 1..250");

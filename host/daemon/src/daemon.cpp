@@ -514,6 +514,7 @@ nlohmann::json Daemon::summary_json() const {
   j["tracker_vmc_messages"] = t.vmc_messages;
   j["tracker_vmc_malformed"] = t.vmc_malformed;
   j["tracker_vmc_ignored"] = t.vmc_ignored;
+  j["tracker_balance"] = t.balance;
   j["avatar_resets"] = cs.avatar_resets;
   j["stiffness_min"] = levels_json(cs.stiffness_min);
   j["stiffness_max"] = levels_json(cs.stiffness_max);

@@ -1,11 +1,14 @@
 #include "tonus/host/daemon/tracker_input.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "tonus/host/reference/body_balance.hpp"
 #include "tonus/host/reference/body_retarget.hpp"
 #include "tonus/host/reference/calibration.hpp"
 #include "tonus/host/reference/tracker_ik.hpp"
@@ -31,7 +34,22 @@ struct TrackerInput::Vmc {
   reference::IkOutput ik_out;
   double scale = 1.0;
   std::string note;  // what happened, for the log (set on the tracker thread, logged there)
+  // performer mode with tracker.balance = "online": the sender's frame time
+  // measured over its first frames, then every sample through the online
+  // balance filter (its output comes the look-ahead later).
+  std::optional<reference::BodyBalance> balance;
+  bool balance_refused = false;                // the filter could not be set up: the stream plays uncorrected (logged)
+  std::vector<std::int64_t> arrivals;          // until the frame time is known
+  std::vector<reference::BodySample> waiting;  // the samples that came meanwhile
+  reference::BodySample balanced;
 };
+
+namespace {
+
+// Frames over which the sender's frame time is measured (the median interval).
+constexpr std::size_t kRateFrames = 30;
+
+}  // namespace
 
 TrackerInput::TrackerInput(const TrackerConfig& config, const sim::Model& model, PhysicsCore& core)
     : config_(config), model_(model), core_(core) {}
@@ -59,6 +77,7 @@ bool TrackerInput::start(std::string& error) {
       const std::lock_guard<std::mutex> lock(mutex_);
       status_.source = fmt::format("bvh {} ({} frames at {:.0f} Hz{})", path, clip_.qpos.size() - clip_.first_frame,
                                    1.0 / clip_.dt_s, config_.bvh_loop ? ", looping" : "");
+      status_.balance = clip_.balance;
     }
     spdlog::info("tracker: {}", status_.source);
     if (!clip_.balance.empty()) spdlog::info("tracker: {}", clip_.balance);
@@ -181,8 +200,14 @@ void TrackerInput::run_vmc() {
     if (!pending) continue;
     pending = false;
     s.t_us = arrival_us;
-    const bool solved = config_.vmc_mode == VmcMode::performer ? solve_body(body, s.qpos)
-                                                               : solve_trackers(trackers, arrival_us, s.qpos);
+    bool solved = false;
+    if (config_.vmc_mode == VmcMode::trackers) {
+      solved = solve_trackers(trackers, arrival_us, s.qpos);
+    } else if (config_.balance == balance::BalanceMode::online && !v.balance_refused) {
+      solved = balance_body(body, arrival_us, s.qpos);
+    } else {
+      solved = solve_body(body, s.qpos);
+    }
     body = reference::BodySample{};
     trackers = reference::TrackerFrame{};
     if (solved) count_frame(core_.push_pose(s));
@@ -205,6 +230,57 @@ bool TrackerInput::solve_body(const reference::BodySample& body, Qpos& qpos) {
   qpos = model_.qpos0;
   v.retarget->solve(body, v.retarget_state, qpos);
   return true;
+}
+
+bool TrackerInput::balance_body(const reference::BodySample& body, std::int64_t arrival_us, Qpos& qpos) {
+  Vmc& v = *vmc_;
+  if (!v.receiver->skeleton()) return false;  // the sender's skeleton is not known yet
+  if (!v.balance) {
+    v.arrivals.push_back(arrival_us);
+    v.waiting.push_back(body);
+    if (v.arrivals.size() < kRateFrames) return false;
+    std::vector<double> gaps;
+    for (std::size_t k = 1; k < v.arrivals.size(); ++k) {
+      gaps.push_back(static_cast<double>(v.arrivals[k] - v.arrivals[k - 1]) * 1e-6);
+    }
+    std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2), gaps.end());
+    const double dt = gaps[gaps.size() / 2];
+    balance::OnlineOptions o;
+    o.dt_s = dt;
+    o.lookahead_s = config_.balance_lookahead_s;
+    reference::BodyBalance::Created made =
+        dt >= 1e-3 && dt <= 0.1 ? reference::BodyBalance::create(*v.receiver->skeleton(), o)
+                                : reference::BodyBalance::Created{"the sender's frame rate is not 10..1000 Hz", {}};
+    if (!made) {
+      spdlog::warn(
+          "tracker: balance (online) cannot run on this VMC performer ({:.1f} Hz measured): {}; the stream "
+          "plays uncorrected",
+          1.0 / dt, made.error);
+      v.balance_refused = true;
+      const std::lock_guard<std::mutex> lock(mutex_);
+      status_.balance = "off (refused: " + made.error + ")";
+      return solve_body(body, qpos);
+    }
+    v.balance = std::move(*made.balance);
+    const std::string note = fmt::format(
+        "online on the VMC performer stream: the sender at {:.1f} Hz (median of {} "
+        "frames), look-ahead {} frames ({:.0f} ms)",
+        1.0 / dt, gaps.size(), v.balance->lookahead_frames(),
+        static_cast<double>(v.balance->lookahead_frames()) * dt * 1e3);
+    spdlog::info("tracker: balance {}", note);
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      status_.balance = note;
+    }
+    // The samples that came while the rate was measured fill the window (their
+    // own outputs are past); the newest goes on below.
+    v.waiting.pop_back();
+    for (const reference::BodySample& w : v.waiting) (void)v.balance->push(w, v.balanced);
+    v.waiting = {};
+    v.arrivals = {};
+  }
+  if (!v.balance->push(body, v.balanced)) return false;
+  return solve_body(v.balanced, qpos);
 }
 
 bool TrackerInput::solve_trackers(reference::TrackerFrame frame, std::int64_t arrival_us, Qpos& qpos) {

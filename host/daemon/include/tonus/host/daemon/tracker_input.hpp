@@ -29,6 +29,7 @@ struct TrackerStatus {
   double rate_hz = 0.0;       // over the last second
   std::uint64_t loops = 0;    // bvh: times the clip restarted
   std::uint64_t vmc_messages = 0, vmc_ignored = 0, vmc_malformed = 0;
+  std::string balance;  // a VMC performer's balance stage: how it runs (empty: off or not started)
 };
 
 class TrackerInput {
@@ -49,6 +50,9 @@ class TrackerInput {
   void run_vmc();
   void count_frame(bool pushed);
   bool solve_body(const reference::BodySample& body, Qpos& qpos);
+  // tracker.balance = "online" on a performer stream: through BodyBalance,
+  // once the sender's frame time is measured; false while the filter fills.
+  bool balance_body(const reference::BodySample& body, std::int64_t arrival_us, Qpos& qpos);
   bool solve_trackers(reference::TrackerFrame frame, std::int64_t arrival_us, Qpos& qpos);
 
   TrackerConfig config_;
