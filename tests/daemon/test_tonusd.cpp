@@ -16,6 +16,7 @@
 
 #include "daemon_fixtures.hpp"
 #include "process.hpp"
+#include "support/scratch_dir.hpp"
 #include "tonus/host/control/client.hpp"
 #include "tonus/host/daemon/pose_buffer.hpp"
 #include "tonus/host/vmc/pose_out.hpp"
@@ -29,7 +30,7 @@ using test::VmcCapture;
 
 namespace {
 
-std::string temp_path(const std::string& name) { return "/tmp/tonusd-test-" + std::to_string(::getpid()) + "-" + name; }
+std::string temp_path(const std::string& name) { return test::scratch_path("tonusd-" + name); }
 
 nlohmann::json run_tonusd(const std::vector<std::string>& args, const std::string& name, std::string* log = nullptr) {
   const std::string json = temp_path(name + ".json");

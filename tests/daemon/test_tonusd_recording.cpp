@@ -10,6 +10,7 @@
 #include <regex>
 
 #include "process.hpp"
+#include "support/scratch_dir.hpp"
 #include "vmc_capture.hpp"
 
 using tonus::test::Process;
@@ -17,7 +18,7 @@ using tonus::test::VmcCapture;
 
 namespace {
 
-std::string temp(const std::string& name) { return "/tmp/tonusd-rec-test-" + std::to_string(::getpid()) + "-" + name; }
+std::string temp(const std::string& name) { return tonus::test::scratch_path("tonusd-rec-" + name); }
 
 struct Run {
   int rc = -1;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "reference_checks.hpp"
+#include "support/scratch_dir.hpp"
 #include "tonus/host/motion/bvh.hpp"
 #include "tonus/sim/humanoid.hpp"
 #include "tonus/sim/model_builder.hpp"
@@ -20,9 +21,9 @@ using reference::ClipReference;
 namespace {
 
 std::string write_temp(const std::string& name, const std::string& text) {
-  const std::filesystem::path p = std::filesystem::temp_directory_path() / name;
+  const std::string p = test::scratch_path(name);
   std::ofstream(p, std::ios::binary) << text;
-  return p.string();
+  return p;
 }
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
