@@ -78,6 +78,18 @@ double angle_between(const std::array<double, 4>& a, const std::array<double, 4>
   return 2.0 * std::acos(std::min(1.0, dot));
 }
 
+// The humanoid's rest with the left arm raised 0.8 rad about the forward axis.
+std::array<double, sim::kMaxQpos> left_arm_raised(const sim::Model& model) {
+  std::array<double, sim::kMaxQpos> q = model.qpos0;
+  const auto arm = static_cast<std::size_t>(model.bodies[sim::index(sim::Bone::LeftUpperArm)].qpos_adr);
+  const sim::Quat up(Eigen::AngleAxisd(0.8, sim::Vec3::UnitX()));
+  q[arm] = up.w();
+  q[arm + 1] = up.x();
+  q[arm + 2] = up.y();
+  q[arm + 3] = up.z();
+  return q;
+}
+
 }  // namespace
 
 TEST_CASE("tonusd --demo: exits 0 with the summary's fields, the VMC output parses, every bone, unit quaternions") {
@@ -230,13 +242,7 @@ TEST_CASE("tonusd: a VMC performer's stream is followed, held when it stops, eas
 
   // The performer raises the left arm 0.8 rad (about the forward axis) and holds it.
   const sim::Model& model = test::daemon_humanoid();
-  std::array<double, sim::kMaxQpos> raised = model.qpos0;
-  const auto arm = static_cast<std::size_t>(model.bodies[sim::index(sim::Bone::LeftUpperArm)].qpos_adr);
-  const sim::Quat up(Eigen::AngleAxisd(0.8, sim::Vec3::UnitX()));
-  raised[arm] = up.w();
-  raised[arm + 1] = up.x();
-  raised[arm + 2] = up.y();
-  raised[arm + 3] = up.z();
+  const std::array<double, sim::kMaxQpos> raised = left_arm_raised(model);
   vmc::VmcPose pose, neutral_pose;
   REQUIRE(vmc::pose_from_qpos(model, raised, pose));
   std::array<double, sim::kMaxQpos> neutral{};
@@ -335,13 +341,7 @@ TEST_CASE("tonusd: a VMC performer's stream through the online balance filter co
   // The performer stands (the humanoid's rest: balanced, so nothing to
   // correct), then raises the left arm 0.8 rad and holds it.
   const sim::Model& model = test::daemon_humanoid();
-  std::array<double, sim::kMaxQpos> raised = model.qpos0;
-  const auto arm = static_cast<std::size_t>(model.bodies[sim::index(sim::Bone::LeftUpperArm)].qpos_adr);
-  const sim::Quat up(Eigen::AngleAxisd(0.8, sim::Vec3::UnitX()));
-  raised[arm] = up.w();
-  raised[arm + 1] = up.x();
-  raised[arm + 2] = up.y();
-  raised[arm + 3] = up.z();
+  const std::array<double, sim::kMaxQpos> raised = left_arm_raised(model);
   vmc::VmcPose standing, lifted;
   REQUIRE(vmc::pose_from_qpos(model, model.qpos0, standing));
   REQUIRE(vmc::pose_from_qpos(model, raised, lifted));

@@ -4,6 +4,8 @@
 #include <exception>
 #include <utility>
 
+#include "stream_checks.hpp"
+
 namespace tonus::reference {
 namespace {
 
@@ -12,11 +14,10 @@ using sim::Quat;
 using sim::Vec3;
 constexpr std::size_t kN = sim::kBoneCount;
 
-std::size_t parent_of(std::size_t i) { return sim::index(*sim::kBones[i].parent); }
+using detail::parent_of;
 
-bool finite_vec(const Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
-// As BodyRetarget's default tolerance: a quaternion further than this from unit is refused.
-bool usable(const Quat& q) { return std::isfinite(q.w()) && finite_vec(q.vec()) && std::abs(q.norm() - 1.0) <= 0.01; }
+// As BodyRetarget's default: a quaternion further than this from unit is refused.
+bool usable(const Quat& q) { return detail::usable(q, BodyRetargetOptions{}.unit_tolerance); }
 
 double bone_length(const SourceSkeleton& s, Bone b) { return s.offset[sim::index(b)].norm(); }
 
@@ -32,7 +33,7 @@ BodyBalance::Created BodyBalance::create(const SourceSkeleton& skeleton, const b
     }
   }
   for (std::size_t i = 0; i < kN; ++i) {
-    if (skeleton.present[i] && !finite_vec(skeleton.offset[i])) {
+    if (skeleton.present[i] && !sim::all_finite(skeleton.offset[i])) {
       c.error = std::string("the skeleton's rest offset of ") + std::string(sim::kBones[i].name) + " is not finite";
       return c;
     }
@@ -106,7 +107,7 @@ bool BodyBalance::push(const BodySample& in, BodySample& out, balance::OnlineFra
     }
   }
   if (in.root_present) {
-    if (finite_vec(in.root_position) && in.root_position.norm() <= 1e3) {
+    if (sim::all_finite(in.root_position) && in.root_position.norm() <= 1e3) {
       last_.root_position = in.root_position;
     } else {
       refused = true;
@@ -143,7 +144,7 @@ bool BodyBalance::take(const balance::OnlineFrame& f, BodySample& out, balance::
     const Quat local = (c.rotation[p].conjugate() * c.rotation[i]).normalized();
     if (usable(local)) out.local[i] = local;
   }
-  if (!finite_vec(out.root_position)) out = held_[f.index % held_.size()];  // not expected: the input instead
+  if (!sim::all_finite(out.root_position)) out = held_[f.index % held_.size()];  // not expected: the input instead
   if (info != nullptr) *info = f;
   return true;
 }

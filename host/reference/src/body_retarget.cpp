@@ -6,6 +6,7 @@
 #include "rig.hpp"
 #include "rotations.hpp"
 #include "smoothstep.hpp"
+#include "stream_checks.hpp"
 #include "tonus/sim/joint_limits.hpp"
 
 namespace tonus::reference {
@@ -39,7 +40,9 @@ constexpr Bone kRequired[] = {Bone::Hips,          Bone::LeftUpperLeg,  Bone::Le
 
 constexpr std::size_t idx(Bone b) { return sim::index(b); }
 constexpr std::uint32_t bit(std::size_t i) { return std::uint32_t{1} << i; }
-std::size_t parent_of(std::size_t i) { return sim::index(*sim::kBones[i].parent); }
+using detail::finite;
+using detail::parent_of;
+using detail::usable;
 
 bool is_foot(Bone b) { return b == Bone::LeftFoot || b == Bone::RightFoot; }
 bool is_shoulder(Bone b) { return b == Bone::LeftShoulder || b == Bone::RightShoulder; }
@@ -50,9 +53,6 @@ bool is_limb_upper(std::size_t i) {
 bool is_limb_lower(std::size_t i) {
   return std::any_of(std::begin(kLimbs), std::end(kLimbs), [&](const Limb& l) { return idx(l.lower) == i; });
 }
-
-bool finite(const Quat& q) { return std::isfinite(q.w()) && sim::all_finite(q.vec()); }
-bool usable(const Quat& q, double tolerance) { return finite(q) && std::abs(q.norm() - 1.0) <= tolerance; }
 
 // The least turn taking a onto b, deterministic when they are opposite (about `fallback_axis`).
 Quat least_turn(const Vec3& a, const Vec3& b, const Vec3& fallback_axis) {
