@@ -207,8 +207,9 @@ IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calib
                         o.tracked_knee_smoothing_s >= 0.0 && o.heading_smoothing2_s >= 0.0 &&
                         o.clavicle_lower_s >= 0.0 && o.chest_twist_smoothing_s >= 0.0;
   const bool sizes_ok = o.step_threshold_m > 0.0 && o.step_turn_rad > 0.0 && o.foot_pivot_start_rad >= 0.0 &&
-                        o.foot_pivot_width_rad >= 0.0 && o.step_lift_m >= 0.0 && o.implausible_reach_factor > 1.0 &&
-                        o.leg_softness_m >= 0.0 && o.stride_softness_m >= 0.0 && o.stride_soft_speed_mps > 0.0;
+                        o.foot_pivot_width_rad >= 0.0 && o.step_lift_m >= 0.0 && o.trunk_turn_limit_rad >= 0.0 &&
+                        o.implausible_reach_factor > 1.0 && o.leg_softness_m >= 0.0 && o.stride_softness_m >= 0.0 &&
+                        o.stride_soft_speed_mps > 0.0;
   const bool shares_ok = o.pelvis_share >= 0.0 && o.spine_share >= 0.0 && o.chest_share >= 0.0 && o.neck_share >= 0.0 &&
                          o.pelvis_share <= 1.0 && o.spine_share <= 1.0 && o.trunk_follows_pelvis >= 0.0 &&
                          o.trunk_follows_pelvis <= 1.0 && o.trunk_tilts_with_pelvis >= 0.0 &&
@@ -380,9 +381,18 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     const Quat rel = (hips.rot * share(o.pelvis_share).conjugate()).normalized();
     const Quat turn_z(Eigen::AngleAxisd(sim::swing_twist(rel, Vec3::UnitZ()).twist_rad, Vec3::UnitZ()));
     const Quat tilt = (rel * turn_z.conjugate()).normalized();
-    const Quat carry = (Quat::Identity().slerp(o.trunk_tilts_with_pelvis, tilt) *
-                        Quat::Identity().slerp(o.trunk_follows_pelvis, turn_z))
-                           .normalized();
+    Quat carry = (Quat::Identity().slerp(o.trunk_tilts_with_pelvis, tilt) *
+                  Quat::Identity().slerp(o.trunk_follows_pelvis, turn_z))
+                     .normalized();
+    // The chest's turn from the pelvis about the vertical, saturated smoothly:
+    // the thorax turns only so far against the pelvis, the neck does the rest.
+    if (o.trunk_turn_limit_rad > 0.0) {
+      const double chest_yaw = yaw_of(carry * w.f.rot[bi(Bone::Chest)] * Vec3::UnitX(), 0.0);
+      const double turn =
+          std::remainder(chest_yaw - yaw_of(hips.rot * Vec3::UnitX(), chest_yaw), 2.0 * std::numbers::pi);
+      const double limited = o.trunk_turn_limit_rad * std::tanh(turn / o.trunk_turn_limit_rad);
+      carry = (yaw_quat(limited - turn) * carry).normalized();
+    }
     const Quat spine = (carry * w.f.rot[bi(Bone::Spine)]).normalized();
     const Quat chest = (carry * w.f.rot[bi(Bone::Chest)]).normalized();
     const Vec3 base = hips.pos_m + hips.rot * m.offset[bi(Bone::Spine)];

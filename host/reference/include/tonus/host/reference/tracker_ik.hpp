@@ -55,6 +55,12 @@ struct IkOptions {
   double trunk_follows_pelvis = 0.5;        // 6 points: the share of the waist tracker's turn (about the vertical) the
                                             // spine and chest take ...
   double trunk_tilts_with_pelvis = 0.25;    // ... and of its tilt and roll
+  // 6 points: the spine and chest's turn about the vertical from the waist
+  // tracker's saturates smoothly (tanh) toward this: the thorax turns against
+  // the pelvis only so far (a kick's head looking 60 degrees off the hips is
+  // the neck's turn), and the head's share dragged the chest off in spins.
+  // 0: no limit.
+  double trunk_turn_limit_rad = 0.5;
   // 6 points: the neck joint goes to the side of the spine-to-head line the
   // guessed trunk names, pulled behind it by this (times the trunk's length):
   // an upright trunk and neck are nearly in line and the guess alone let the
