@@ -680,7 +680,16 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
       if (leg.norm() > 1e-6) raw_knee += leg.normalized().cross(target.rot * m.hinge_axis[bi(shank)]);
     }
     // Smoothed as the elbows' (a foot's quick turns are the ankle's), longer
-    // over a tracked foot, whose axis rolls with the ankle.
+    // over a tracked foot, whose axis rolls with the ankle. First carried, as
+    // the elbow's, with the hip-ankle line's turn since the last frame, so a
+    // whole leg swinging fast (a kick) keeps its knee's side rather than
+    // dragging a cue left behind.
+    if (const Vec3 leg = target.pos_m - hip[s]; leg.norm() > 1e-6) {
+      if (st.started && st.leg_line[s].norm() > 0.5) {
+        st.knee_pole[s] = (sim::quat_from_two_vectors(st.leg_line[s], leg.normalized()) * st.knee_pole[s]).normalized();
+      }
+      st.leg_line[s] = leg.normalized();
+    }
     const bool foot_worn = m.calibration.offset[index(kFootTracker[s])].valid && ft.seen;
     smooth_pole(st.knee_pole[s], raw_knee, body_yaw * Vec3::UnitX(), !st.started,
                 detail::first_order_share(dt, foot_worn ? o.tracked_knee_smoothing_s : o.knee_smoothing_s));

@@ -220,6 +220,7 @@ struct IkState {
   std::array<sim::Vec3, 2> elbow_last{};         // the last solved upper arm's direction, chest's frame
   std::array<sim::Vec3, 2> arm_line{};           // the last shoulder-to-wrist direction, chest's frame, unit
   std::array<sim::Vec3, 2> knee_pole{};          // in the world, smoothed, unit
+  std::array<sim::Vec3, 2> leg_line{};           // the last hip-to-ankle direction, world, unit
   sim::Vec3 last_pelvis = sim::Vec3::Zero();
   sim::Vec3 pelvis_velocity = sim::Vec3::Zero();
   double stride_soft_share = 0.0;  // [0, 1]: how much of stride_softness_m the procedural legs take now
