@@ -205,7 +205,8 @@ IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calib
                         o.heading_smoothing_s >= 0.0 && o.waist_heading_smoothing_s >= 0.0 &&
                         o.elbow_smoothing_s >= 0.0 && o.stride_soft_fade_s >= 0.0 && o.knee_smoothing_s >= 0.0 &&
                         o.tracked_knee_smoothing_s >= 0.0 && o.heading_smoothing2_s >= 0.0 &&
-                        o.clavicle_lower_s >= 0.0 && o.chest_twist_smoothing_s >= 0.0;
+                        o.clavicle_lower_s >= 0.0 && o.chest_twist_smoothing_s >= 0.0 && o.chest_twist_lead_s >= 0.0 &&
+                        o.chest_twist_lead_smoothing_s >= 0.0 && o.chest_twist_lead_speed_mps >= 0.0;
   const bool sizes_ok = o.step_threshold_m > 0.0 && o.step_turn_rad > 0.0 && o.foot_pivot_start_rad >= 0.0 &&
                         o.foot_pivot_width_rad >= 0.0 && o.step_lift_m >= 0.0 && o.trunk_turn_limit_rad >= 0.0 &&
                         o.implausible_reach_factor > 1.0 && o.leg_softness_m >= 0.0 && o.stride_softness_m >= 0.0 &&
@@ -426,8 +427,22 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     for (std::size_t s = 0; s < 2; ++s) {
       const IkState::Track& tr = st.track[index(kHand[s])];
       if (!m.calibration.offset[index(kHand[s])].valid || !tr.seen) continue;
-      const Vec3 hand_pos = tr.target.valid ? tr.target.pos_m : tr.shown.pos_m;
+      const Vec3 hand_now = tr.target.valid ? tr.target.pos_m : tr.shown.pos_m;
       const Vec3 shoulder = w.f.pos[bi(kClavicle[s])] + w.f.rot[bi(Bone::Chest)] * m.offset[bi(kUpperArm[s])];
+      // A hand flung outward is taken a little further out (chest_twist_lead_s),
+      // its speed away from this shoulder measured with the shoulder held.
+      Vec3 hand_pos = hand_now;
+      const double dist = (hand_now - shoulder).norm();
+      if (st.started && dt > 0.0) {
+        const double speed = (dist - (st.twist_hand[s] - shoulder).norm()) / dt;
+        st.twist_hand_speed[s] +=
+            detail::first_order_share(dt, o.chest_twist_lead_smoothing_s) * (speed - st.twist_hand_speed[s]);
+        const double lead = o.chest_twist_lead_s * std::max(0.0, st.twist_hand_speed[s] - o.chest_twist_lead_speed_mps);
+        if (dist > 1e-9) hand_pos = shoulder + (1.0 + lead / dist) * (hand_now - shoulder);
+      } else if (!st.started) {
+        st.twist_hand_speed[s] = 0.0;
+      }
+      st.twist_hand[s] = hand_now;
       // Beyond the factor's margin (a hanging arm is about at full reach),
       // the twist that brings the shoulder back to the arm's reach: the
       // target steps there, the two stages below make it smooth.

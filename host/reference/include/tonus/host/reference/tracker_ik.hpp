@@ -78,6 +78,15 @@ struct IkOptions {
   double chest_twist_reach_factor = 1.04;
   double chest_twist_max_rad = 0.8;
   double chest_twist_smoothing_s = 0.07;
+  // A hand flung outward faster than chest_twist_lead_speed_mps (its speed
+  // away from the shoulder, smoothed over chest_twist_lead_smoothing_s) is
+  // taken chest_twist_lead_s times the excess further out for the twist: the
+  // two stages delay the twist by about their time constants, and a kick's
+  // flung arm was past the reach before the chest turned. A hand swinging
+  // (a walk) or slower is taken where it is.
+  double chest_twist_lead_s = 0.07;
+  double chest_twist_lead_speed_mps = 1.0;
+  double chest_twist_lead_smoothing_s = 0.02;
   double default_pole_weight = 0.25;  // elbows: the anatomical pole (down, back) against the hand's
   double elbow_stay_weight = 3.0;     // a bent arm's elbow kept on its last side, against the smoothed cue's 1
   double elbow_roll_weight = 0.5;     // elbows: the hand's roll (the elbow's axis, least wrist twist) against it
@@ -215,6 +224,8 @@ struct IkState {
   double body_yaw_stage_rad = 0.0;               // the heading's first smoothing stage (3 points)
   std::array<double, 2> clavicle_share{};        // the clavicles' last share of their turn (eased down)
   std::array<double, 2> chest_twist_rad{};       // the chest's twist toward a far hand: stage 1, stage 2
+  std::array<sim::Vec3, 2> twist_hand{};         // the hands' last positions, for their speed away from the shoulder
+  std::array<double, 2> twist_hand_speed{};      // ... that speed, smoothed (m/s)
   sim::Quat trunk_turn = sim::Quat::Identity();  // the head's turn from the heading, smoothed
   std::array<sim::Vec3, 2> elbow_pole{};         // in the chest's frame, smoothed, unit
   std::array<sim::Vec3, 2> elbow_last{};         // the last solved upper arm's direction, chest's frame
