@@ -325,7 +325,8 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
   double yaw = yaw_of(facing, st.body_yaw_rad);
   // The heading smoothed, so the hands' quick swings do not shake the trunk
   // (the head stays exact). 6 points: longer, as it only shapes the trunk
-  // the waist tracker carries (a kick's flailing hands turned the chest).
+  // the waist tracker carries (a kick's flailing hands turned the chest), and
+  // that trunk's turn from the waist is bounded (trunk_turn_limit_rad).
   // 3 points: two stages, so a quick swing's heading comes in smoothly
   // rather than with a first-order step's kink (the kicks' flailing hands).
   if (st.started) {

@@ -47,14 +47,14 @@ struct IkOptions {
   double spine_share = 0.12;
   double chest_share = 0.25;
   double neck_share = 0.6;
-  double hands_heading_weight = 0.3;        // the hands' say in the body's heading, against the head's 1
-  double heading_smoothing_s = 0.02;        // time constant of that heading, 3 points (0: none) ...
-  double heading_smoothing2_s = 0.02;       // ... then of a second stage after it (3 points only; 0: none)
-  double waist_heading_smoothing_s = 0.05;  // ... and 6 points (it only shapes the trunk the waist carries)
-  double trunk_smoothing_s = 0.05;          // time constant of the head turn the trunk bones share (0: none)
-  double trunk_follows_pelvis = 0.5;        // 6 points: the share of the waist tracker's turn (about the vertical) the
-                                            // spine and chest take ...
-  double trunk_tilts_with_pelvis = 0.25;    // ... and of its tilt and roll
+  double hands_heading_weight = 0.3;       // the hands' say in the body's heading, against the head's 1
+  double heading_smoothing_s = 0.02;       // time constant of that heading, 3 points (0: none) ...
+  double heading_smoothing2_s = 0.02;      // ... then of a second stage after it (3 points only; 0: none)
+  double waist_heading_smoothing_s = 0.1;  // ... and 6 points (it only shapes the trunk the waist carries)
+  double trunk_smoothing_s = 0.05;         // time constant of the head turn the trunk bones share (0: none)
+  double trunk_follows_pelvis = 0.5;       // 6 points: the share of the waist tracker's turn (about the vertical) the
+                                           // spine and chest take ...
+  double trunk_tilts_with_pelvis = 0.25;   // ... and of its tilt and roll
   // 6 points: the spine and chest's turn about the vertical from the waist
   // tracker's saturates smoothly (tanh) toward this: the thorax turns against
   // the pelvis only so far (a kick's head looking 60 degrees off the hips is
