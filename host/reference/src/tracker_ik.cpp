@@ -205,10 +205,12 @@ IkCreated make_ik_model(const sim::Model& humanoid, const BodyCalibration& calib
                         o.heading_smoothing_s >= 0.0 && o.waist_heading_smoothing_s >= 0.0 &&
                         o.elbow_smoothing_s >= 0.0 && o.stride_soft_fade_s >= 0.0 && o.knee_smoothing_s >= 0.0 &&
                         o.tracked_knee_smoothing_s >= 0.0 && o.heading_smoothing2_s >= 0.0 &&
-                        o.clavicle_lower_s >= 0.0 && o.chest_twist_smoothing_s >= 0.0;
+                        o.clavicle_lower_s >= 0.0 && o.chest_twist_smoothing_s >= 0.0 && o.chest_twist_lead_s >= 0.0 &&
+                        o.chest_twist_lead_smoothing_s >= 0.0 && o.chest_twist_lead_speed_mps >= 0.0;
   const bool sizes_ok = o.step_threshold_m > 0.0 && o.step_turn_rad > 0.0 && o.foot_pivot_start_rad >= 0.0 &&
-                        o.foot_pivot_width_rad >= 0.0 && o.step_lift_m >= 0.0 && o.implausible_reach_factor > 1.0 &&
-                        o.leg_softness_m >= 0.0 && o.stride_softness_m >= 0.0 && o.stride_soft_speed_mps > 0.0;
+                        o.foot_pivot_width_rad >= 0.0 && o.step_lift_m >= 0.0 && o.trunk_turn_limit_rad >= 0.0 &&
+                        o.implausible_reach_factor > 1.0 && o.leg_softness_m >= 0.0 && o.stride_softness_m >= 0.0 &&
+                        o.stride_soft_speed_mps > 0.0;
   const bool shares_ok = o.pelvis_share >= 0.0 && o.spine_share >= 0.0 && o.chest_share >= 0.0 && o.neck_share >= 0.0 &&
                          o.pelvis_share <= 1.0 && o.spine_share <= 1.0 && o.trunk_follows_pelvis >= 0.0 &&
                          o.trunk_follows_pelvis <= 1.0 && o.trunk_tilts_with_pelvis >= 0.0 &&
@@ -323,7 +325,8 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
   double yaw = yaw_of(facing, st.body_yaw_rad);
   // The heading smoothed, so the hands' quick swings do not shake the trunk
   // (the head stays exact). 6 points: longer, as it only shapes the trunk
-  // the waist tracker carries (a kick's flailing hands turned the chest).
+  // the waist tracker carries (a kick's flailing hands turned the chest), and
+  // that trunk's turn from the waist is bounded (trunk_turn_limit_rad).
   // 3 points: two stages, so a quick swing's heading comes in smoothly
   // rather than with a first-order step's kink (the kicks' flailing hands).
   if (st.started) {
@@ -380,9 +383,18 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     const Quat rel = (hips.rot * share(o.pelvis_share).conjugate()).normalized();
     const Quat turn_z(Eigen::AngleAxisd(sim::swing_twist(rel, Vec3::UnitZ()).twist_rad, Vec3::UnitZ()));
     const Quat tilt = (rel * turn_z.conjugate()).normalized();
-    const Quat carry = (Quat::Identity().slerp(o.trunk_tilts_with_pelvis, tilt) *
-                        Quat::Identity().slerp(o.trunk_follows_pelvis, turn_z))
-                           .normalized();
+    Quat carry = (Quat::Identity().slerp(o.trunk_tilts_with_pelvis, tilt) *
+                  Quat::Identity().slerp(o.trunk_follows_pelvis, turn_z))
+                     .normalized();
+    // The chest's turn from the pelvis about the vertical, saturated smoothly:
+    // the thorax turns only so far against the pelvis, the neck does the rest.
+    if (o.trunk_turn_limit_rad > 0.0) {
+      const double chest_yaw = yaw_of(carry * w.f.rot[bi(Bone::Chest)] * Vec3::UnitX(), 0.0);
+      const double turn =
+          std::remainder(chest_yaw - yaw_of(hips.rot * Vec3::UnitX(), chest_yaw), 2.0 * std::numbers::pi);
+      const double limited = o.trunk_turn_limit_rad * std::tanh(turn / o.trunk_turn_limit_rad);
+      carry = (yaw_quat(limited - turn) * carry).normalized();
+    }
     const Quat spine = (carry * w.f.rot[bi(Bone::Spine)]).normalized();
     const Quat chest = (carry * w.f.rot[bi(Bone::Chest)]).normalized();
     const Vec3 base = hips.pos_m + hips.rot * m.offset[bi(Bone::Spine)];
@@ -416,8 +428,22 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
     for (std::size_t s = 0; s < 2; ++s) {
       const IkState::Track& tr = st.track[index(kHand[s])];
       if (!m.calibration.offset[index(kHand[s])].valid || !tr.seen) continue;
-      const Vec3 hand_pos = tr.target.valid ? tr.target.pos_m : tr.shown.pos_m;
+      const Vec3 hand_now = tr.target.valid ? tr.target.pos_m : tr.shown.pos_m;
       const Vec3 shoulder = w.f.pos[bi(kClavicle[s])] + w.f.rot[bi(Bone::Chest)] * m.offset[bi(kUpperArm[s])];
+      // A hand flung outward is taken a little further out (chest_twist_lead_s),
+      // its speed away from this shoulder measured with the shoulder held.
+      Vec3 hand_pos = hand_now;
+      const double dist = (hand_now - shoulder).norm();
+      if (st.started && dt > 0.0) {
+        const double speed = (dist - (st.twist_hand[s] - shoulder).norm()) / dt;
+        st.twist_hand_speed[s] +=
+            detail::first_order_share(dt, o.chest_twist_lead_smoothing_s) * (speed - st.twist_hand_speed[s]);
+        const double lead = o.chest_twist_lead_s * std::max(0.0, st.twist_hand_speed[s] - o.chest_twist_lead_speed_mps);
+        if (dist > 1e-9) hand_pos = shoulder + (1.0 + lead / dist) * (hand_now - shoulder);
+      } else if (!st.started) {
+        st.twist_hand_speed[s] = 0.0;
+      }
+      st.twist_hand[s] = hand_now;
       // Beyond the factor's margin (a hanging arm is about at full reach),
       // the twist that brings the shoulder back to the arm's reach: the
       // target steps there, the two stages below make it smooth.
@@ -670,7 +696,16 @@ void solve_ik(const IkModel& m, IkState& st, const TrackerFrame& frame, IkOutput
       if (leg.norm() > 1e-6) raw_knee += leg.normalized().cross(target.rot * m.hinge_axis[bi(shank)]);
     }
     // Smoothed as the elbows' (a foot's quick turns are the ankle's), longer
-    // over a tracked foot, whose axis rolls with the ankle.
+    // over a tracked foot, whose axis rolls with the ankle. First carried, as
+    // the elbow's, with the hip-ankle line's turn since the last frame, so a
+    // whole leg swinging fast (a kick) keeps its knee's side rather than
+    // dragging a cue left behind.
+    if (const Vec3 leg = target.pos_m - hip[s]; leg.norm() > 1e-6) {
+      if (st.started && st.leg_line[s].norm() > 0.5) {
+        st.knee_pole[s] = (sim::quat_from_two_vectors(st.leg_line[s], leg.normalized()) * st.knee_pole[s]).normalized();
+      }
+      st.leg_line[s] = leg.normalized();
+    }
     const bool foot_worn = m.calibration.offset[index(kFootTracker[s])].valid && ft.seen;
     smooth_pole(st.knee_pole[s], raw_knee, body_yaw * Vec3::UnitX(), !st.started,
                 detail::first_order_share(dt, foot_worn ? o.tracked_knee_smoothing_s : o.knee_smoothing_s));

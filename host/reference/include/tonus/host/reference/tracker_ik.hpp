@@ -47,14 +47,20 @@ struct IkOptions {
   double spine_share = 0.12;
   double chest_share = 0.25;
   double neck_share = 0.6;
-  double hands_heading_weight = 0.3;        // the hands' say in the body's heading, against the head's 1
-  double heading_smoothing_s = 0.02;        // time constant of that heading, 3 points (0: none) ...
-  double heading_smoothing2_s = 0.02;       // ... then of a second stage after it (3 points only; 0: none)
-  double waist_heading_smoothing_s = 0.05;  // ... and 6 points (it only shapes the trunk the waist carries)
-  double trunk_smoothing_s = 0.05;          // time constant of the head turn the trunk bones share (0: none)
-  double trunk_follows_pelvis = 0.5;        // 6 points: the share of the waist tracker's turn (about the vertical) the
-                                            // spine and chest take ...
-  double trunk_tilts_with_pelvis = 0.25;    // ... and of its tilt and roll
+  double hands_heading_weight = 0.3;       // the hands' say in the body's heading, against the head's 1
+  double heading_smoothing_s = 0.02;       // time constant of that heading, 3 points (0: none) ...
+  double heading_smoothing2_s = 0.02;      // ... then of a second stage after it (3 points only; 0: none)
+  double waist_heading_smoothing_s = 0.1;  // ... and 6 points (it only shapes the trunk the waist carries)
+  double trunk_smoothing_s = 0.05;         // time constant of the head turn the trunk bones share (0: none)
+  double trunk_follows_pelvis = 0.5;       // 6 points: the share of the waist tracker's turn (about the vertical) the
+                                           // spine and chest take ...
+  double trunk_tilts_with_pelvis = 0.25;   // ... and of its tilt and roll
+  // 6 points: the spine and chest's turn about the vertical from the waist
+  // tracker's saturates smoothly (tanh) toward this: the thorax turns against
+  // the pelvis only so far (a kick's head looking 60 degrees off the hips is
+  // the neck's turn), and the head's share dragged the chest off in spins.
+  // 0: no limit.
+  double trunk_turn_limit_rad = 0.5;
   // 6 points: the neck joint goes to the side of the spine-to-head line the
   // guessed trunk names, pulled behind it by this (times the trunk's length):
   // an upright trunk and neck are nearly in line and the guess alone let the
@@ -72,6 +78,15 @@ struct IkOptions {
   double chest_twist_reach_factor = 1.04;
   double chest_twist_max_rad = 0.8;
   double chest_twist_smoothing_s = 0.07;
+  // A hand flung outward faster than chest_twist_lead_speed_mps (its speed
+  // away from the shoulder, smoothed over chest_twist_lead_smoothing_s) is
+  // taken chest_twist_lead_s times the excess further out for the twist: the
+  // two stages delay the twist by about their time constants, and a kick's
+  // flung arm was past the reach before the chest turned. A hand swinging
+  // (a walk) or slower is taken where it is.
+  double chest_twist_lead_s = 0.07;
+  double chest_twist_lead_speed_mps = 1.0;
+  double chest_twist_lead_smoothing_s = 0.02;
   double default_pole_weight = 0.25;  // elbows: the anatomical pole (down, back) against the hand's
   double elbow_stay_weight = 3.0;     // a bent arm's elbow kept on its last side, against the smoothed cue's 1
   double elbow_roll_weight = 0.5;     // elbows: the hand's roll (the elbow's axis, least wrist twist) against it
@@ -209,11 +224,14 @@ struct IkState {
   double body_yaw_stage_rad = 0.0;               // the heading's first smoothing stage (3 points)
   std::array<double, 2> clavicle_share{};        // the clavicles' last share of their turn (eased down)
   std::array<double, 2> chest_twist_rad{};       // the chest's twist toward a far hand: stage 1, stage 2
+  std::array<sim::Vec3, 2> twist_hand{};         // the hands' last positions, for their speed away from the shoulder
+  std::array<double, 2> twist_hand_speed{};      // ... that speed, smoothed (m/s)
   sim::Quat trunk_turn = sim::Quat::Identity();  // the head's turn from the heading, smoothed
   std::array<sim::Vec3, 2> elbow_pole{};         // in the chest's frame, smoothed, unit
   std::array<sim::Vec3, 2> elbow_last{};         // the last solved upper arm's direction, chest's frame
   std::array<sim::Vec3, 2> arm_line{};           // the last shoulder-to-wrist direction, chest's frame, unit
   std::array<sim::Vec3, 2> knee_pole{};          // in the world, smoothed, unit
+  std::array<sim::Vec3, 2> leg_line{};           // the last hip-to-ankle direction, world, unit
   sim::Vec3 last_pelvis = sim::Vec3::Zero();
   sim::Vec3 pelvis_velocity = sim::Vec3::Zero();
   double stride_soft_share = 0.0;  // [0, 1]: how much of stride_softness_m the procedural legs take now
