@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "tonus/host/daemon/sender_frames.hpp"
 #include "tonus/host/reference/body_balance.hpp"
 #include "tonus/host/reference/body_retarget.hpp"
 #include "tonus/host/reference/calibration.hpp"
@@ -167,7 +168,16 @@ void TrackerInput::run_vmc() {
   reference::TrackerFrame trackers;
   bool pending = false;
   std::int64_t arrival_us = 0;
+  // With the online balance filter, the sender's own frames (sender_frames.hpp).
+  const bool balancing = config_.vmc_mode == VmcMode::performer && config_.balance == balance::BalanceMode::online;
+  SenderFrames framer;
+  std::vector<SenderFrame> finished;
   v.receiver->set_handler([&](const vmc::ReceivedFrame& f) {
+    if (balancing && f.mode == vmc::ReceiverMode::performer) {
+      const auto& skeleton = v.receiver->skeleton();
+      framer.add(f.body, f.arrival_us, skeleton ? &skeleton->present : nullptr, finished);
+      return;
+    }
     if (f.mode == vmc::ReceiverMode::performer) {
       for (std::size_t b = 0; b < sim::kBoneCount; ++b) {
         if (!f.body.present[b]) continue;
@@ -197,14 +207,22 @@ void TrackerInput::run_vmc() {
       status_.vmc_ignored = c.ignored;
       status_.vmc_malformed = c.malformed;
     }
+    if (balancing) {
+      for (const SenderFrame& frame : finished) {
+        s.t_us = frame.arrival_us;
+        const bool solved =
+            v.balance_refused ? solve_body(frame.body, s.qpos) : balance_body(frame.body, frame.arrival_us, s.qpos);
+        if (solved) count_frame(core_.push_pose(s));
+      }
+      finished.clear();
+      continue;
+    }
     if (!pending) continue;
     pending = false;
     s.t_us = arrival_us;
     bool solved = false;
     if (config_.vmc_mode == VmcMode::trackers) {
       solved = solve_trackers(trackers, arrival_us, s.qpos);
-    } else if (config_.balance == balance::BalanceMode::online && !v.balance_refused) {
-      solved = balance_body(body, arrival_us, s.qpos);
     } else {
       solved = solve_body(body, s.qpos);
     }
