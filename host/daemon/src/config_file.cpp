@@ -351,8 +351,9 @@ std::string to_toml(const DaemonConfig& c) {
   out += "\n[tracker]\n";
   out += fmt::format("source = \"{}\"  # bvh, vmc, none\n", to_string(t.source));
   out += fmt::format("bvh_path = {}  # empty: the bundled clip\nbvh_loop = {}\n", q(t.bvh_path), t.bvh_loop);
-  out += fmt::format("balance = \"{}\"  # off, offline (bvh), online (bvh or vmc performer)\nbalance_lookahead_ms = {}\n",
-                     balance::to_string(t.balance), t.balance_lookahead_s * 1e3);
+  out +=
+      fmt::format("balance = \"{}\"  # off, offline (bvh), online (bvh or vmc performer)\nbalance_lookahead_ms = {}\n",
+                  balance::to_string(t.balance), t.balance_lookahead_s * 1e3);
   out += fmt::format("vmc_mode = \"{}\"  # performer, trackers\n", to_string(t.vmc_mode));
   out += fmt::format("listen_address = {}\nlisten_port = {}\n", q(t.listen_address), t.listen_port);
   out += fmt::format("delay_ms = {}\nhold_ms = {}\nease_ms = {}\nrecover_ms = {}\n", t.buffer.delay_s * 1e3,
