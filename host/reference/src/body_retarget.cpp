@@ -40,7 +40,6 @@ constexpr Bone kRequired[] = {Bone::Hips,          Bone::LeftUpperLeg,  Bone::Le
 
 constexpr std::size_t idx(Bone b) { return sim::index(b); }
 constexpr std::uint32_t bit(std::size_t i) { return std::uint32_t{1} << i; }
-using detail::finite;
 using detail::parent_of;
 using detail::usable;
 
