@@ -220,12 +220,8 @@ void TrackerInput::run_vmc() {
     if (!pending) continue;
     pending = false;
     s.t_us = arrival_us;
-    bool solved = false;
-    if (config_.vmc_mode == VmcMode::trackers) {
-      solved = solve_trackers(trackers, arrival_us, s.qpos);
-    } else {
-      solved = solve_body(body, s.qpos);
-    }
+    const bool solved = config_.vmc_mode == VmcMode::performer ? solve_body(body, s.qpos)
+                                                               : solve_trackers(trackers, arrival_us, s.qpos);
     body = reference::BodySample{};
     trackers = reference::TrackerFrame{};
     if (solved) count_frame(core_.push_pose(s));

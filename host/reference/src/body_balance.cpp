@@ -14,8 +14,6 @@ using sim::Quat;
 using sim::Vec3;
 constexpr std::size_t kN = sim::kBoneCount;
 
-using detail::parent_of;
-
 // As BodyRetarget's default: a quaternion further than this from unit is refused.
 bool usable(const Quat& q) { return detail::usable(q, BodyRetargetOptions{}.unit_tolerance); }
 
@@ -64,11 +62,7 @@ BodyBalance::BodyBalance(const SourceSkeleton& skeleton, const balance::Skeleton
                          balance::OnlineBalance filter)
     : skeleton_(skeleton), geometry_(geometry), filter_(std::move(filter)) {
   parent_.fill(-1);
-  for (std::size_t i = 1; i < kN; ++i) {
-    std::size_t p = parent_of(i);
-    while (p != 0 && !skeleton_.present[p]) p = parent_of(p);
-    parent_[i] = static_cast<int>(p);
-  }
+  for (std::size_t i = 1; i < kN; ++i) parent_[i] = static_cast<int>(detail::present_parent(skeleton_.present, i));
   skeleton_.present[0] = true;
   // Until a value arrives: the rest.
   last_.present = skeleton_.present;

@@ -155,8 +155,7 @@ BodyRetargetBuild BodyRetarget::create(const sim::Model& humanoid, const SourceS
   src_pos[0] = s.offset[0];
   for (std::size_t i = 1; i < kN; ++i) {
     if (!s.present[i]) continue;
-    std::size_t p = parent_of(i);
-    while (!s.present[p]) p = parent_of(p);  // Hips is present
+    const std::size_t p = detail::present_parent(s.present, i);  // Hips is present
     r.source_parent_[i] = static_cast<int>(p);
     r.source_rest_world_[i] = (r.source_rest_world_[p] * s.rest_rotation[i]).normalized();
     src_pos[i] = src_pos[p] + r.source_rest_world_[p] * s.offset[i];
