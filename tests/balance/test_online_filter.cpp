@@ -256,4 +256,28 @@ TEST_CASE("online balance filter: a non-finite frame is taken as the one before,
   CHECK(c.filter->non_finite_frames() == 2);
 }
 
+TEST_CASE(
+    "online balance filter: the constrained planner, on the Bandai walk, has fewer frames outside under every "
+    "member") {
+  // Measured 2026-12-04 (default margin 1.5 cm, weight 20): 120 / 119 / 135 /
+  // 135 / 140 / 141 / 145 / 144 -> 32 / 37 / 63 / 71 / 88 / 92 / 101 / 105 of
+  // 195 (the plain preview: 29 / 32 / 56 / 59 / 76 / 77 / 105 / 106).
+  const test::Loaded l = test::load(test::shared_clip("dataset-1_walk_normal_001.bvh"));
+  const HumanMotion& m = l.conversion.motion;
+  OnlineOptions o = options_for(m);
+  o.constraint_weight = 20.0;
+  const Streamed s = stream(m, o, m.size());
+  const std::vector<AnalysisOptions> members = estimator_family(o.analysis);
+  const Analysis base = analyse(m, o.analysis);
+  const FamilyVerdict before = family_verdict(analyse_family(m, members, base.contacts), members);
+  const FamilyVerdict after = family_verdict(analyse_family(s.corrected, members, base.contacts), members);
+  for (std::size_t i = 0; i < members.size(); ++i) {
+    MESSAGE(members[i].derivatives.cutoff_hz << " Hz " << std::string(members[i].angular_momentum ? "full" : "particle")
+                                             << ": " << before.members[i].outside << " -> "
+                                             << after.members[i].outside);
+    CHECK(after.members[i].outside * 4 < before.members[i].outside * 3);
+  }
+  CHECK(after.members[0].outside * 3 < before.members[0].outside);  // the 4 Hz particle: under a third
+}
+
 }  // namespace tonus::balance

@@ -79,6 +79,11 @@ int run(int argc, char** argv) {
   zmp_cmd->add_option("--lookahead", zmp.lookahead_s, "--online: how far ahead the filter sees, s")
       ->check(CLI::Range(0.001, 0.25));
   zmp_cmd
+      ->add_option("--plan-weight", zmp.plan_weight,
+                   "--online: plan with the support polygons ahead as constraints, their violation weighted this "
+                   "much against the tracking (default 0: the plain preview; 20 was measured, docs/balance.md)")
+      ->check(CLI::Range(0.0, 1000.0));
+  zmp_cmd
       ->add_option(
           "--margin", zmp.margin_m,
           "Aim this far inside the support polygon, m (default: the correction's own; 1 cm, the robust filter 2 cm)")

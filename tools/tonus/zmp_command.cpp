@@ -123,6 +123,7 @@ bool online_result(const balance::HumanMotion& motion, const balance::AnalysisOp
   oo.dt_s = motion.dt_s;
   oo.lookahead_s = opt.lookahead_s;
   oo.margin_m = opt.margin_m > 0.0 ? opt.margin_m : 0.01;
+  oo.constraint_weight = opt.plan_weight;
   balance::OnlineRun run = balance::run_online(motion, oo);
   if (!run.ok()) {
     error = run.error;

@@ -5,6 +5,7 @@
 #include <span>
 #include <utility>
 
+#include "constrained_preview.hpp"
 #include "tonus/host/balance/filter.hpp"
 #include "tonus/host/balance/zmp.hpp"
 
@@ -14,6 +15,24 @@ namespace {
 constexpr double kMaxDrop_m = 0.008;
 // The least weight of a frame's ZMP error (its support ratio, below).
 constexpr double kMinErrorWeight = 0.2;
+// The most rows one frame gives the planner: its support polygon's edges (up
+// to 12; a hull of two soles has eight corners), the shift cap's 4 and the
+// legs' 2. More are dropped and counted by the planner.
+constexpr std::size_t kRowsPerFrame = 18;
+// Each leg's hip, knee and ankle; kept from straightening beyond this share
+// of its length, as the waist correction keeps it (waist.cpp).
+constexpr std::array<std::array<std::size_t, 3>, 2> kLegJoints = {
+    {{sim::index(sim::Bone::LeftUpperLeg), sim::index(sim::Bone::LeftLowerLeg), sim::index(sim::Bone::LeftFoot)},
+     {sim::index(sim::Bone::RightUpperLeg), sim::index(sim::Bone::RightLowerLeg), sim::index(sim::Bone::RightFoot)}}};
+constexpr double kLegReach = 0.999;
+// Beyond the planner's horizon the last frame's rows are taken as held and
+// priced by a Riccati cost-to-go of tracking weight Q + this share of the
+// violation weight (constrained_preview.hpp). The whole weight keeps the
+// plan exactly on a held constraint but damps it (Bandai walk, worst member
+// 117 of 195 against 106 with the plain preview); Q alone, or Q + W/20, lets
+// a held violation run away; a quarter is stable on a held violation at 30
+// and 120 Hz (test_constrained_preview.cpp) and better on the clips.
+constexpr double kHeldShare = 0.25;
 
 bool finite_frame(const MotionFrame& f) {
   for (const Vec3& p : f.p) {
@@ -44,6 +63,8 @@ OnlineBalance::Created OnlineBalance::create(const OnlineOptions& o) {
   } else if (!positive(o.margin_m) || !positive(o.max_shift_m) || !positive(o.jerk_weight) ||
              !positive(o.com_height_m)) {
     c.error = "margin, shift cap, jerk weight and centre-of-mass height must be finite and positive";
+  } else if (!(std::isfinite(o.constraint_weight) && o.constraint_weight >= 0.0)) {
+    c.error = "the constraint weight must be finite and not negative";
   } else if (!(o.max_fine_shift_m >= 0.0 && o.max_fine_shift_m <= o.max_shift_m)) {
     c.error = "the fine shift cap must lie in [0, shift cap]";
   }
@@ -89,11 +110,29 @@ OnlineBalance::OnlineBalance(const OnlineOptions& options, std::size_t lag, cons
       polygons_(lag + 1),
       window_(kSegmentParts * (lag + 1)),
       zmp_(lag + 1, Vec2::Zero()),
+      weight_(lag + 1, 0.0),
       outside_(lag + 1, 0.0),
       defined_(lag + 1, false) {
   errors_[0].assign(lag + 1, 0.0);
   errors_[1].assign(lag + 1, 0.0);
+  if (options.constraint_weight > 0.0) {
+    PreviewOptions tail;
+    tail.dt_s = options.dt_s;
+    tail.com_height_m = options.com_height_m;
+    tail.preview_frames = lag;
+    tail.jerk_weight = options.jerk_weight;
+    tail.gravity = options.analysis.gravity;
+    tail.tracking_weight = 1.0 + kHeldShare * options.constraint_weight;
+    const PreviewModel held = preview_model(tail);
+    planner_ = std::make_unique<detail::ConstrainedPreview>(preview_, held.ok() ? held.P : preview_.P, lag, 1.0,
+                                                            options.jerk_weight, options.offset_weight,
+                                                            options.constraint_weight, kRowsPerFrame);
+  }
 }
+
+OnlineBalance::OnlineBalance(OnlineBalance&&) noexcept = default;
+OnlineBalance& OnlineBalance::operator=(OnlineBalance&&) noexcept = default;
+OnlineBalance::~OnlineBalance() = default;
 
 bool OnlineBalance::push(const MotionFrame& in, OnlineFrame& out) {
   const std::size_t slot = pushed_ % (lag_ + 1);
@@ -155,6 +194,7 @@ void OnlineBalance::window_errors() {
     const ZmpResult z = zero_moment_point(mass_, zi, ground, g);
     errors_[0][w] = errors_[1][w] = 0.0;
     defined_[w] = valid && z.defined;
+    weight_[w] = std::clamp(z.support_ratio, kMinErrorWeight, 1.0);
     zmp_[w] = z.zmp;
     outside_[w] = 0.0;
     const ConvexPolygon& poly = polygons_[k % (lag_ + 1)];
@@ -165,7 +205,7 @@ void OnlineBalance::window_errors() {
       // Where the feet carry only part of the weight (a bounce's trough), a
       // shift's acceleration moves the ZMP by the inverse of that share, and
       // the estimators disagree most: the cart asks for the share of the move.
-      const double weight = std::clamp(z.support_ratio, kMinErrorWeight, 1.0);
+      const double weight = weight_[w];
       errors_[0][w] = weight * (target.x() - z.zmp.x());
       errors_[1][w] = weight * (target.y() - z.zmp.y());
     }
@@ -229,10 +269,17 @@ void OnlineBalance::emit(std::size_t frames_back, OnlineFrame& out) {
   const Vec2 applied = (shift - fine) * share;
   for (std::size_t a = 0; a < 2; ++a) {
     if (options_.anti_windup) cart_[a].x() = applied[static_cast<Eigen::Index>(a)];
-    // The errors after this frame (at least one: the last is held).
-    const std::size_t first = std::min(w + 1, held - 1);
-    const std::span<const double> ahead(errors_[a].data() + first, held - first);
-    preview_step(preview_, cart_[a], ahead);
+  }
+  if (planner_) {
+    plan_rows(w, held);
+    planner_->step(cart_);
+  } else {
+    for (std::size_t a = 0; a < 2; ++a) {
+      // The errors after this frame (at least one: the last is held).
+      const std::size_t first = std::min(w + 1, held - 1);
+      const std::span<const double> ahead(errors_[a].data() + first, held - first);
+      preview_step(preview_, cart_[a], ahead);
+    }
   }
   out.share = share;
   out.index = k;
@@ -244,6 +291,63 @@ void OnlineBalance::emit(std::size_t frames_back, OnlineFrame& out) {
   out.outside_before_m = outside_[w];
   out.reachable = reachable;
   ++emitted_;
+}
+
+// The planner's half-planes for the frames after window position w: each
+// edge of a frame's support polygon bounds the cart's ZMP move d by
+// n . (z + d / weight) <= n . edge - margin (the move's weight as the error's:
+// where the feet carry part of the weight, a shift moves the ZMP further).
+// Beyond the newest frame the newest is held.
+void OnlineBalance::plan_rows(std::size_t w, std::size_t held) {
+  using Bounds = detail::ConstrainedPreview::Bounds;
+  constexpr double kFarEnough_m = 0.25;  // an edge this far beyond what a move can reach cannot bind
+  planner_->clear_rows();
+  for (std::size_t s = 1; s <= planner_->horizon(); ++s) {
+    const std::size_t pos = std::min(w + s, held - 1);
+    const std::size_t k = pushed_ - held + pos;
+    // The offset, as the pelvis shift it asks for (divided by the share the
+    // centre of mass follows): within the cap, and within each leg's reach of
+    // its ankle with the pelvis lowered by at most the drop allowed (the
+    // reach's disc taken by its tangent).
+    const double cap = options_.max_shift_m * share_;
+    for (const Vec2& axis : {Vec2(1.0, 0.0), Vec2(0.0, 1.0)}) {
+      planner_->add_row(s, Bounds::offset, axis, cap);
+      planner_->add_row(s, Bounds::offset, -axis, cap);
+    }
+    const MotionFrame& f = frames_[k % (lag_ + 1)];
+    for (const auto& leg : kLegJoints) {
+      const Vec3 hip = f.p[leg[0]], knee = f.p[leg[1]], ankle = f.p[leg[2]];
+      const double reach = std::max(kLegReach * ((knee - hip).norm() + (ankle - knee).norm()), (ankle - hip).norm());
+      const double height = std::max(hip.z() - ankle.z() - kMaxDrop_m, 0.0);
+      const double across = std::sqrt(std::max(reach * reach - height * height, 0.0));
+      const Vec2 out = (hip - ankle).head<2>();
+      const double dist = out.norm();
+      if (dist < 1e-6 || across - dist > kFarEnough_m) continue;
+      planner_->add_row(s, Bounds::offset, out / dist, share_ * (across - dist));
+    }
+    if (!defined_[pos]) continue;
+    const ConvexPolygon& poly = polygons_[k % (lag_ + 1)];
+    const Vec2 z = zmp_[pos];
+    const double weight = weight_[pos];
+    if (poly.vertices.size() >= 3) {
+      for (std::size_t i = 0; i < poly.vertices.size(); ++i) {
+        const Vec2& p0 = poly.vertices[i];
+        const Vec2& p1 = poly.vertices[(i + 1) % poly.vertices.size()];
+        const Vec2 edge = p1 - p0;
+        const double len = edge.norm();
+        if (len < 1e-9) continue;
+        const Vec2 normal(edge.y() / len, -edge.x() / len);  // outward: the vertices run counter-clockwise
+        const double bound = weight * (normal.dot(p0) - options_.margin_m - normal.dot(z));
+        if (bound < kFarEnough_m) planner_->add_row(s, Bounds::zmp, normal, bound);
+      }
+    } else if (!poly.vertices.empty()) {
+      // A point or a segment: toward its nearest point.
+      const Vec2 target = nearest_point_inset(poly, z, options_.margin_m);
+      const Vec2 away = z - target;
+      const double dist = away.norm();
+      if (dist > 1e-9) planner_->add_row(s, Bounds::zmp, away / dist, -weight * dist);
+    }
+  }
 }
 
 }  // namespace tonus::balance

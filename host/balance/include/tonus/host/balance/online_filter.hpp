@@ -27,6 +27,7 @@
 
 #include <array>
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -34,6 +35,10 @@
 #include "tonus/host/balance/analysis.hpp"
 #include "tonus/host/balance/preview_control.hpp"
 #include "tonus/host/derivatives/fixed_lag.hpp"
+
+namespace tonus::balance::detail {
+class ConstrainedPreview;
+}
 
 namespace tonus::balance {
 
@@ -55,7 +60,15 @@ struct OnlineOptions {
   // up, and overshoots when the limit lets go).
   bool anti_windup = true;
   double jerk_weight = 1e-6;  // preview control's R / Q (Kajita's)
-  double com_height_m = 0.9;  // the cart-table's height: the centre of mass above the ground, standing
+  // The support polygons ahead (and the shift cap and the legs' reach) as
+  // constraints on the plan (host/balance/src/constrained_preview.hpp) instead
+  // of one reference move per frame: the weight of a violation's square
+  // against the tracking's. 0 (the default): the plain preview. Not yet the
+  // default: measured against it in docs/balance.md, better under the family
+  // on every clip but worse on the Bandai walk under the independent estimator.
+  double constraint_weight = 0.0;
+  double offset_weight = 0.0;  // with the planner: its centre-of-mass offset's weight, against the tracking's
+  double com_height_m = 0.9;   // the cart-table's height: the centre of mass above the ground, standing
 };
 
 // One corrected frame.
@@ -82,6 +95,9 @@ class OnlineBalance {
   // the derivatives library refuses. Everything is allocated here (the
   // preview gains solved); push allocates only when a sole is measured again.
   static Created create(const OnlineOptions& options);
+  OnlineBalance(OnlineBalance&&) noexcept;
+  OnlineBalance& operator=(OnlineBalance&&) noexcept;
+  ~OnlineBalance();
 
   // Feeds the next frame. Once more than the look-ahead has arrived, fills
   // `out` with the frame `lookahead_frames()` before this one and returns true.
@@ -99,6 +115,7 @@ class OnlineBalance {
  private:
   OnlineBalance(const OnlineOptions& options, std::size_t lag, const derivatives::FixedLag3& smoother,
                 PreviewModel preview);
+  void plan_rows(std::size_t w, std::size_t held);
   void window_errors();
   void emit(std::size_t frames_back, OnlineFrame& out);
 
@@ -108,6 +125,7 @@ class OnlineBalance {
   CausalContacts contacts_;
   std::vector<derivatives::FixedLag3> segments_;  // one per mass part
   PreviewModel preview_;
+  std::unique_ptr<detail::ConstrainedPreview> planner_;                                    // null: the plain preview
   std::array<Eigen::Vector3d, 2> cart_{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};  // x, y offsets
   // Rings over the window (lag + 1 frames), frame k at k % (lag + 1).
   std::vector<MotionFrame> frames_;
@@ -118,6 +136,7 @@ class OnlineBalance {
   // Per window position (0 = the oldest): the ZMP error ahead, per axis.
   std::array<std::vector<double>, 2> errors_;
   std::vector<Vec2> zmp_;
+  std::vector<double> weight_;  // per window position: the error's weight (support ratio)
   std::vector<double> outside_;
   std::vector<bool> defined_;
   double share_ = 0.0;  // of a pelvis shift, what the centre of mass follows (measured on the first frame out)
