@@ -80,8 +80,9 @@ int run(int argc, char** argv) {
       ->check(CLI::Range(0.001, 0.25));
   zmp_cmd
       ->add_option("--plan-weight", zmp.plan_weight,
-                   "--online: plan with the support polygons ahead as constraints, their violation weighted this "
-                   "much against the tracking (default 0: the plain preview; 20 was measured, docs/balance.md)")
+                   "--online: the planner's weight of a violation of the support polygons ahead against the "
+                   "ZMP tracking (0: Kajita's plain preview, one reference move per frame)")
+      ->capture_default_str()
       ->check(CLI::Range(0.0, 1000.0));
   zmp_cmd
       ->add_option(

@@ -8,6 +8,8 @@
 #include <optional>
 #include <string>
 
+#include "tonus/host/balance/online_filter.hpp"
+
 namespace tonus::tools {
 
 struct ZmpCommandOptions {
@@ -31,8 +33,9 @@ struct ZmpCommandOptions {
       "waist";                // waist (the robust filter, the default) or rotation (waist rotation, one estimator)
   bool online = false;        // the streaming filter (pelvis shift by preview control, bounded look-ahead)
   double lookahead_s = 0.25;  // --online: how far ahead it sees, s (at most 0.25)
-  double plan_weight = 0.0;   // --online: the constrained planner's violation weight (0: the plain preview)
-  double margin_m = -1.0;     // negative: the correction's own (rotation 1 cm, waist 2 cm, online 1 cm)
+  // --online: the planner's violation weight (0: the plain preview).
+  double plan_weight = balance::OnlineOptions{}.constraint_weight;
+  double margin_m = -1.0;  // negative: the correction's own (rotation 1 cm, waist 2 cm, online 1 cm)
   double max_correction_rad = 1.0;
   int max_iterations = 100;
   bool keep_tpose = false;

@@ -1,11 +1,28 @@
 #include "constrained_preview.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace tonus::balance::detail {
 namespace {
 constexpr int kMaxPasses = 12;
+
+// The Cholesky factor U (A = U'U) in place of A's upper triangle, unblocked:
+// Eigen's blocked LLT asks the heap for its product's workspace at dynamic
+// sizes, and a frame's plan must not allocate. False if A is not positive
+// definite (numerically).
+bool factor_upper(Eigen::MatrixXd& a) {
+  const Eigen::Index n = a.rows();
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double d2 = a(j, j) - a.col(j).head(j).squaredNorm();
+    if (!(d2 > 0.0)) return false;
+    const double d = std::sqrt(d2);
+    a(j, j) = d;
+    for (Eigen::Index k = j + 1; k < n; ++k) a(j, k) = (a(j, k) - a.col(j).head(j).dot(a.col(k).head(j))) / d;
+  }
+  return true;
 }
+}  // namespace
 
 ConstrainedPreview::ConstrainedPreview(const PreviewModel& model, const Eigen::Matrix3d& tail_cost, std::size_t horizon,
                                        double tracking_weight, double jerk_weight, double offset_weight,
@@ -16,7 +33,6 @@ ConstrainedPreview::ConstrainedPreview(const PreviewModel& model, const Eigen::M
       weight_(violation_weight),
       tracking_(tracking_weight),
       per_frame_(std::clamp<std::size_t>(rows_per_frame, 1, 32)),  // rest_offset keeps a 32-bit mask
-      llt_(static_cast<Eigen::Index>(2 * n_)),
       rows_(n_ * per_frame_),
       count_(n_, 0),
       active_(n_ * per_frame_, 0),
@@ -104,26 +120,42 @@ void ConstrainedPreview::add_gram(const Eigen::MatrixXd& g, const Eigen::VectorX
 // The rest offset the last frame's rows ask for: the least of
 // Q |x|^2 + W sum max(0, n . x - h)^2 (at rest the cart's ZMP is its offset,
 // so both kinds of row bound it alike).
-Eigen::Vector2d ConstrainedPreview::rest_offset() const {
-  const std::size_t last = (n_ - 1) * per_frame_;
+// The soft optimum of one frame's rows at rest: the least of
+// Q |x|^2 + W sum max(0, n . x - h)^2 (at rest the cart's ZMP is its offset,
+// so both kinds of row bound it alike).
+Eigen::Vector2d ConstrainedPreview::frame_rest(std::size_t j) const {
   Eigen::Vector2d x = Eigen::Vector2d::Zero();
-  unsigned mask = 0;
   for (int pass = 0; pass < kMaxPasses; ++pass) {
     Eigen::Matrix2d h = tracking_ * Eigen::Matrix2d::Identity();
     Eigen::Vector2d g = Eigen::Vector2d::Zero();
-    unsigned now = 0;
-    for (std::size_t k = 0; k < count_[n_ - 1]; ++k) {
-      const Row& row = rows_[last + k];
+    for (std::size_t k = 0; k < count_[j]; ++k) {
+      const Row& row = rows_[j * per_frame_ + k];
       if (row.normal.dot(x) <= row.bound) continue;
-      now |= 1U << k;
       h += weight_ * row.normal * row.normal.transpose();
       g += weight_ * row.normal * row.bound;
     }
-    if (pass > 0 && now == mask) break;
-    mask = now;
-    x = h.ldlt().solve(g);
+    const Eigen::Vector2d next = h.ldlt().solve(g);
+    const bool settled = (next - x).norm() < 1e-12;
+    x = next;
+    if (settled) break;
   }
   return x;
+}
+
+// What every frame of the look-ahead asks for at rest: of the frames' own
+// soft optima, the one nearest zero. A demand held over the whole look-ahead
+// (a performer leaning for seconds) is held beyond it too, so the plan settles
+// on it; one that comes and goes with the steps is not, so the plan returns
+// toward zero. (Holding the newest frame's demand instead, or the whole
+// window's, follows the estimates' noise and bias: on the Bandai walk the
+// independent estimator's count after rose from 82 to 118.)
+Eigen::Vector2d ConstrainedPreview::rest_offset() const {
+  Eigen::Vector2d best = frame_rest(0);
+  for (std::size_t j = 1; j < n_ && best.squaredNorm() > 0.0; ++j) {
+    const Eigen::Vector2d r = frame_rest(j);
+    if (r.squaredNorm() < best.squaredNorm()) best = r;
+  }
+  return best;
 }
 
 int ConstrainedPreview::step(std::array<Eigen::Vector3d, 2>& state) {
@@ -190,15 +222,23 @@ int ConstrainedPreview::step(std::array<Eigen::Vector3d, 2>& state) {
     system_.topRightCorner(n, n).setZero();
     add_gram(g_, s_xx_, s_xy_, s_yy_);
     add_gram(gx_, o_xx_, o_xy_, o_yy_);
-    rhs_.head(n).noalias() = -base_f_ * state[0] + tail_ * rest.x();
-    rhs_.tail(n).noalias() = -base_f_ * state[1] + tail_ * rest.y();
+    // Products one at a time, each straight into rhs_ (a product inside a
+    // sum would be evaluated into a temporary on the heap).
+    rhs_.head(n) = tail_ * rest.x();
+    rhs_.tail(n) = tail_ * rest.y();
+    rhs_.head(n).noalias() -= base_f_ * state[0];
+    rhs_.tail(n).noalias() -= base_f_ * state[1];
     rhs_.head(n).noalias() -= g_.transpose() * e_x_;
     rhs_.tail(n).noalias() -= g_.transpose() * e_y_;
     rhs_.head(n).noalias() -= gx_.transpose() * oe_x_;
     rhs_.tail(n).noalias() -= gx_.transpose() * oe_y_;
-    llt_.compute(system_.selfadjointView<Eigen::Upper>());
+    if (!factor_upper(system_)) {  // cannot happen with a positive jerk weight; keep the last plan
+      ++failed_;
+      break;
+    }
     u_ = rhs_;
-    llt_.solveInPlace(u_);
+    system_.triangularView<Eigen::Upper>().transpose().solveInPlace(u_);
+    system_.triangularView<Eigen::Upper>().solveInPlace(u_);
   }
   state[0] = a_ * state[0] + b_ * u_(0);
   state[1] = a_ * state[1] + b_ * u_(n);

@@ -56,6 +56,9 @@ class ConstrainedPreview {
 
   [[nodiscard]] std::size_t horizon() const { return n_; }
   [[nodiscard]] std::size_t dropped_rows() const { return dropped_; }
+  // Plans whose system could not be factored (the last plan kept); none with
+  // a positive jerk weight.
+  [[nodiscard]] std::size_t failed_plans() const { return failed_; }
 
  private:
   struct Row {
@@ -63,6 +66,7 @@ class ConstrainedPreview {
     double bound;
     Bounds what;
   };
+  [[nodiscard]] Eigen::Vector2d frame_rest(std::size_t frame) const;
   [[nodiscard]] Eigen::Vector2d rest_offset() const;
   void add_gram(const Eigen::MatrixXd& g, const Eigen::VectorXd& sxx, const Eigen::VectorXd& sxy,
                 const Eigen::VectorXd& syy);
@@ -85,11 +89,11 @@ class ConstrainedPreview {
   // Per frame, over its active rows of each kind: W sum n n' (xx, xy, yy) and
   // W sum n (n . v0 - h).
   Eigen::VectorXd s_xx_, s_xy_, s_yy_, e_x_, e_y_, o_xx_, o_xy_, o_yy_, oe_x_, oe_y_;
-  Eigen::LLT<Eigen::MatrixXd> llt_;
   std::vector<Row> rows_;           // n * per_frame_, frame j's at [j * per_frame_, ...)
   std::vector<std::size_t> count_;  // per frame
   std::vector<unsigned char> active_, previous_;
   std::size_t dropped_ = 0;
+  std::size_t failed_ = 0;
 };
 
 }  // namespace tonus::balance::detail

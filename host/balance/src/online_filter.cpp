@@ -25,13 +25,14 @@ constexpr std::array<std::array<std::size_t, 3>, 2> kLegJoints = {
     {{sim::index(sim::Bone::LeftUpperLeg), sim::index(sim::Bone::LeftLowerLeg), sim::index(sim::Bone::LeftFoot)},
      {sim::index(sim::Bone::RightUpperLeg), sim::index(sim::Bone::RightLowerLeg), sim::index(sim::Bone::RightFoot)}}};
 constexpr double kLegReach = 0.999;
-// Beyond the planner's horizon the last frame's rows are taken as held and
-// priced by a Riccati cost-to-go of tracking weight Q + this share of the
-// violation weight (constrained_preview.hpp). The whole weight keeps the
-// plan exactly on a held constraint but damps it (Bandai walk, worst member
-// 117 of 195 against 106 with the plain preview); Q alone, or Q + W/20, lets
-// a held violation run away; a quarter is stable on a held violation at 30
-// and 120 Hz (test_constrained_preview.cpp) and better on the clips.
+// Beyond the planner's horizon, what every frame of the look-ahead asks is
+// taken as held and priced by a Riccati cost-to-go of tracking weight Q + this
+// share of the violation weight (constrained_preview.hpp). Measured with the
+// violation weight 20 on a held 5 cm demand: Q + W/10 or less runs away (the
+// plan pushes the violation past the horizon, frame after frame), Q + W/5
+// settles (test_constrained_preview.cpp); on the clips a lower share is
+// better (the whole weight: Bandai walk, worst member 100 against 89), so a
+// quarter, with a margin from the edge.
 constexpr double kHeldShare = 0.25;
 
 bool finite_frame(const MotionFrame& f) {

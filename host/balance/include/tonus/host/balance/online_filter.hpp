@@ -12,10 +12,12 @@
 // - every frame of the window gets its particle ZMP and support polygon, and
 //   the ZMP error: how far the ZMP must move to lie `margin` inside (zero where
 //   it already does, where no foot is down, and where the ZMP is undefined);
-// - Kajita's preview control on the cart-table model, one per horizontal axis,
-//   turns the errors ahead into a centre-of-mass offset whose cart ZMP
-//   (offset - z_c / g * its acceleration) follows them: it starts moving
-//   before the error arrives and eases out after;
+// - preview control on the cart-table model plans a centre-of-mass offset
+//   whose cart ZMP (offset - z_c / g * its acceleration) keeps every frame of
+//   the window inside its polygon (each edge a half-plane, as are the shift
+//   cap and each leg's reach; both axes at once): it starts moving before the
+//   error arrives and eases out after (Kajita's plain preview, one reference
+//   move per frame and axis, with constraint_weight 0);
 // - the offset becomes a horizontal pelvis shift (the feet stay: the legs are
 //   re-solved by the same two-bone IK as the offline filters), divided by the
 //   share of the body's mass that moves with the pelvis at that frame and
@@ -60,13 +62,12 @@ struct OnlineOptions {
   // up, and overshoots when the limit lets go).
   bool anti_windup = true;
   double jerk_weight = 1e-6;  // preview control's R / Q (Kajita's)
-  // The support polygons ahead (and the shift cap and the legs' reach) as
-  // constraints on the plan (host/balance/src/constrained_preview.hpp) instead
-  // of one reference move per frame: the weight of a violation's square
-  // against the tracking's. 0 (the default): the plain preview. Not yet the
-  // default: measured against it in docs/balance.md, better under the family
-  // on every clip but worse on the Bandai walk under the independent estimator.
-  double constraint_weight = 0.0;
+  // The planner (host/balance/src/constrained_preview.hpp): the support
+  // polygons ahead, the shift cap and each leg's reach are half-planes on the
+  // plan, and this weights a violation's square against the ZMP tracking's.
+  // 0: Kajita's plain preview, one reference move per frame (what this filter
+  // was until 2026-12-04; measured against the planner in docs/balance.md).
+  double constraint_weight = 20.0;
   double offset_weight = 0.0;  // with the planner: its centre-of-mass offset's weight, against the tracking's
   double com_height_m = 0.9;   // the cart-table's height: the centre of mass above the ground, standing
 };
