@@ -87,7 +87,8 @@ int run(int argc, char** argv) {
   zmp_cmd
       ->add_option(
           "--margin", zmp.margin_m,
-          "Aim this far inside the support polygon, m (default: the correction's own; 1 cm, the robust filter 2 cm)")
+          "Aim this far inside the support polygon, m (default: the correction's own; 1 cm, the robust filter 2 cm, "
+          "--online 1.5 cm)")
       ->check(CLI::Range(0.0, 0.05));
   zmp_cmd
       ->add_option("--max-correction", zmp.max_correction_rad,

@@ -122,7 +122,7 @@ bool online_result(const balance::HumanMotion& motion, const balance::AnalysisOp
   oo.analysis = base;
   oo.dt_s = motion.dt_s;
   oo.lookahead_s = opt.lookahead_s;
-  oo.margin_m = opt.margin_m > 0.0 ? opt.margin_m : 0.01;
+  if (opt.margin_m > 0.0) oo.margin_m = opt.margin_m;  // else the filter's own, as tonusd runs it
   oo.constraint_weight = opt.plan_weight;
   balance::OnlineRun run = balance::run_online(motion, oo);
   if (!run.ok()) {
