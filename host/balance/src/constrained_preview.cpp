@@ -32,7 +32,7 @@ ConstrainedPreview::ConstrainedPreview(const PreviewModel& model, const Eigen::M
       n_(std::max<std::size_t>(horizon, 1)),
       weight_(violation_weight),
       tracking_(tracking_weight),
-      per_frame_(std::clamp<std::size_t>(rows_per_frame, 1, 32)),  // rest_offset keeps a 32-bit mask
+      per_frame_(std::max<std::size_t>(rows_per_frame, 1)),
       rows_(n_ * per_frame_),
       count_(n_, 0),
       active_(n_ * per_frame_, 0),

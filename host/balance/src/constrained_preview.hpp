@@ -31,7 +31,7 @@ namespace tonus::balance::detail {
 
 class ConstrainedPreview {
  public:
-  // `rows_per_frame`: the most half-planes one frame may carry (1 .. 32).
+  // `rows_per_frame`: the most half-planes one frame may carry (at least 1).
   // `tail_cost`: the Riccati solution that prices the state beyond the
   // horizon. With the model's own P the first jerk with no rows is the
   // infinite-horizon regulator's; the online filter passes the P of a tracking
