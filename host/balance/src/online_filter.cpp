@@ -42,6 +42,19 @@ bool finite_frame(const MotionFrame& f) {
   return true;
 }
 
+// The cart-table preview's options for the filter's rate, look-ahead and
+// height, at a tracking weight.
+PreviewOptions preview_options(const OnlineOptions& o, std::size_t lag, double tracking_weight) {
+  PreviewOptions po;
+  po.dt_s = o.dt_s;
+  po.com_height_m = o.com_height_m;
+  po.preview_frames = lag;
+  po.tracking_weight = tracking_weight;
+  po.jerk_weight = o.jerk_weight;
+  po.gravity = o.analysis.gravity;
+  return po;
+}
+
 // How much of a horizontal pelvis shift the whole body's centre of mass
 // follows at this frame (the legs bend to keep the feet, so less than 1).
 double shift_share(const MassModel& mass, const MotionFrame& f) {
@@ -82,13 +95,7 @@ OnlineBalance::Created OnlineBalance::create(const OnlineOptions& o) {
     c.error = "smoothing: " + std::string(derivatives::to_string(smoother.status.error));
     return c;
   }
-  PreviewOptions po;
-  po.dt_s = o.dt_s;
-  po.com_height_m = o.com_height_m;
-  po.preview_frames = lag;
-  po.jerk_weight = o.jerk_weight;
-  po.gravity = o.analysis.gravity;
-  PreviewModel preview = preview_model(po);
+  PreviewModel preview = preview_model(preview_options(o, lag, 1.0));
   if (!preview.ok()) {
     c.error = "preview control: " + preview.error;
     return c;
@@ -117,14 +124,8 @@ OnlineBalance::OnlineBalance(const OnlineOptions& options, std::size_t lag, cons
   errors_[0].assign(lag + 1, 0.0);
   errors_[1].assign(lag + 1, 0.0);
   if (options.constraint_weight > 0.0) {
-    PreviewOptions tail;
-    tail.dt_s = options.dt_s;
-    tail.com_height_m = options.com_height_m;
-    tail.preview_frames = lag;
-    tail.jerk_weight = options.jerk_weight;
-    tail.gravity = options.analysis.gravity;
-    tail.tracking_weight = 1.0 + kHeldShare * options.constraint_weight;
-    const PreviewModel held = preview_model(tail);
+    const PreviewModel held =
+        preview_model(preview_options(options, lag, 1.0 + kHeldShare * options.constraint_weight));
     planner_ = std::make_unique<detail::ConstrainedPreview>(preview_, held.ok() ? held.P : preview_.P, lag, 1.0,
                                                             options.jerk_weight, options.offset_weight,
                                                             options.constraint_weight, kRowsPerFrame);
