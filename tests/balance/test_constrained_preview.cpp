@@ -107,7 +107,7 @@ TEST_CASE("constrained preview: an oblique edge moves both axes along its normal
   CHECK(std::abs(d.x() - d.y()) < 1e-6);  // nothing across the normal
 }
 
-TEST_CASE("constrained preview: a full frame drops the row and counts it; steps outside the horizon are refused") {
+TEST_CASE("constrained preview: a full frame drops the row and counts it, and steps outside the horizon are refused") {
   const PreviewModel m = model_at(1.0 / 30.0, 8);
   ConstrainedPreview plan(m, m.P, 8, 1.0, 1e-6, 0.0, 20.0, 2);
   CHECK(plan.add_row(1, Bounds::zmp, Eigen::Vector2d(1, 0), 0.0));
