@@ -29,7 +29,7 @@ TEST_CASE("constrained preview: with no rows it is the Riccati regulator, -K s")
   for (const auto& [dt, frames] : {std::pair{1.0 / 120.0, std::size_t{30}}, std::pair{1.0 / 30.0, std::size_t{8}}}) {
     const PreviewModel m = model_at(dt, frames);
     REQUIRE_MESSAGE(m.ok(), m.error);
-    ConstrainedPreview plan(m, m.P, frames, 1.0, 1e-6, 0.0, 20.0, 4);
+    ConstrainedPreview plan(m, m.P, frames, 1.0, 1e-6, 20.0, 4);
     std::array<Eigen::Vector3d, 2> s{Eigen::Vector3d(0.03, -0.1, 0.5), Eigen::Vector3d(-0.02, 0.05, -0.3)};
     std::array<Eigen::Vector3d, 2> lqr = s;
     for (int k = 0; k < 20; ++k) {
@@ -47,7 +47,7 @@ TEST_CASE("constrained preview: a held half-plane is met as its soft closed form
   // frame, least at d = -W 0.05 / (Q + W).
   const double w = 20.0, need = 0.05;
   const PreviewModel m = model_at(1.0 / 120.0, 30);
-  ConstrainedPreview plan(m, model_at(1.0 / 120.0, 30, 1.0 + w).P, 30, 1.0, 1e-6, 0.0, w, 4);
+  ConstrainedPreview plan(m, model_at(1.0 / 120.0, 30, 1.0 + w).P, 30, 1.0, 1e-6, w, 4);
   std::array<Eigen::Vector3d, 2> s{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   for (int k = 0; k < 600; ++k) {
     plan.clear_rows();
@@ -79,7 +79,7 @@ TEST_CASE("constrained preview: with the online filter's held cost (Q + W / 4) a
   const double w = 20.0, need = 0.05;
   for (const auto& [dt, frames] : {std::pair{1.0 / 120.0, std::size_t{30}}, std::pair{1.0 / 30.0, std::size_t{8}}}) {
     const PreviewModel m = model_at(dt, frames);
-    ConstrainedPreview plan(m, model_at(dt, frames, 1.0 + 0.25 * w).P, frames, 1.0, 1e-6, 0.0, w, 4);
+    ConstrainedPreview plan(m, model_at(dt, frames, 1.0 + 0.25 * w).P, frames, 1.0, 1e-6, w, 4);
     std::array<Eigen::Vector3d, 2> s{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
     for (int k = 0; k < 2000; ++k) {
       plan.clear_rows();
@@ -94,7 +94,7 @@ TEST_CASE("constrained preview: with the online filter's held cost (Q + W / 4) a
 TEST_CASE("constrained preview: an oblique edge moves both axes along its normal") {
   const double w = 20.0, need = 0.04;
   const PreviewModel m = model_at(1.0 / 30.0, 8);
-  ConstrainedPreview plan(m, model_at(1.0 / 30.0, 8, 1.0 + w).P, 8, 1.0, 1e-6, 0.0, w, 4);
+  ConstrainedPreview plan(m, model_at(1.0 / 30.0, 8, 1.0 + w).P, 8, 1.0, 1e-6, w, 4);
   const Eigen::Vector2d n = Eigen::Vector2d(1.0, 1.0).normalized();
   std::array<Eigen::Vector3d, 2> s{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   for (int k = 0; k < 300; ++k) {
@@ -109,7 +109,7 @@ TEST_CASE("constrained preview: an oblique edge moves both axes along its normal
 
 TEST_CASE("constrained preview: a full frame drops the row and counts it, and steps outside the horizon are refused") {
   const PreviewModel m = model_at(1.0 / 30.0, 8);
-  ConstrainedPreview plan(m, m.P, 8, 1.0, 1e-6, 0.0, 20.0, 2);
+  ConstrainedPreview plan(m, m.P, 8, 1.0, 1e-6, 20.0, 2);
   CHECK(plan.add_row(1, Bounds::zmp, Eigen::Vector2d(1, 0), 0.0));
   CHECK(plan.add_row(1, Bounds::zmp, Eigen::Vector2d(0, 1), 0.0));
   CHECK_FALSE(plan.add_row(1, Bounds::zmp, Eigen::Vector2d(-1, 0), 0.0));

@@ -21,7 +21,7 @@ TEST_CASE("constrained preview: step allocates nothing") {
   const PreviewModel held = preview_model(o);
   REQUIRE(m.ok());
   REQUIRE(held.ok());
-  detail::ConstrainedPreview plan(m, held.P, 30, 1.0, 1e-6, 0.0, 20.0, 18);
+  detail::ConstrainedPreview plan(m, held.P, 30, 1.0, 1e-6, 20.0, 18);
   std::array<Eigen::Vector3d, 2> s{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   const std::array<Eigen::Vector2d, 4> normals{Eigen::Vector2d(1, 0), Eigen::Vector2d(-1, 0), Eigen::Vector2d(0, 1),
                                                Eigen::Vector2d(0, -1)};

@@ -25,8 +25,8 @@ bool factor_upper(Eigen::MatrixXd& a) {
 }  // namespace
 
 ConstrainedPreview::ConstrainedPreview(const PreviewModel& model, const Eigen::Matrix3d& tail_cost, std::size_t horizon,
-                                       double tracking_weight, double jerk_weight, double offset_weight,
-                                       double violation_weight, std::size_t rows_per_frame)
+                                       double tracking_weight, double jerk_weight, double violation_weight,
+                                       std::size_t rows_per_frame)
     : a_(model.A),
       b_(model.B),
       n_(std::max<std::size_t>(horizon, 1)),
@@ -67,13 +67,11 @@ ConstrainedPreview::ConstrainedPreview(const PreviewModel& model, const Eigen::M
   const auto inner = g_.topRows(n - 1);
   const auto inner_f = f_.topRows(n - 1);
   base_ = tracking_weight * inner.transpose() * inner + gn.transpose() * tail_cost * gn;
-  base_ += offset_weight * gx_.transpose() * gx_;
   base_.diagonal().array() += jerk_weight;
-  base_f_ = tracking_weight * inner.transpose() * inner_f + offset_weight * gx_.transpose() * fx_ +
-            gn.transpose() * tail_cost * power;
-  // Beyond the horizon the last frame's rows are taken as held (as the plain
-  // preview holds its last reference): the cost-to-go is P about the rest
-  // state at the offset those rows ask for, x*, so s_n' P s_n becomes
+  base_f_ = tracking_weight * inner.transpose() * inner_f + gn.transpose() * tail_cost * power;
+  // Beyond the horizon the demand the whole look-ahead shares is taken as held
+  // (as the plain preview holds its last reference): the cost-to-go is P about
+  // the rest state at that offset, x* (rest_offset), so s_n' P s_n becomes
   // (s_n - e1 x*)' P (s_n - e1 x*).
   tail_ = gn.transpose() * tail_cost.col(0);
   system_.setZero(2 * n, 2 * n);
@@ -117,9 +115,6 @@ void ConstrainedPreview::add_gram(const Eigen::MatrixXd& g, const Eigen::VectorX
   }
 }
 
-// The rest offset the last frame's rows ask for: the least of
-// Q |x|^2 + W sum max(0, n . x - h)^2 (at rest the cart's ZMP is its offset,
-// so both kinds of row bound it alike).
 // The soft optimum of one frame's rows at rest: the least of
 // Q |x|^2 + W sum max(0, n . x - h)^2 (at rest the cart's ZMP is its offset,
 // so both kinds of row bound it alike).

@@ -10,13 +10,15 @@
 // (n . d <= h), and the plan over the look-ahead minimises
 //   sum_j Q |d_j|^2 + R |u_j|^2 + s_N' P s_N + W sum_rows max(0, n . d_j - h)^2,
 // both horizontal axes at once (the polygon's edges couple them), with the
-// Riccati solution P as the cost beyond the horizon, about the rest state the
-// last frame's rows ask for (the plain preview likewise holds its last
-// reference; with no rows the first jerk is the infinite-horizon regulator's). The hinge is solved by Gauss-Newton on
-// its active rows (exact for a piecewise quadratic: it stops when the active set repeats). Only the first jerk is
-// applied; the plan is made again next frame.
+// Riccati solution P as the cost beyond the horizon, about the rest state
+// every frame of the look-ahead asks for (rest_offset; the plain preview
+// likewise holds its last reference; with no rows the first jerk is the
+// infinite-horizon regulator's). Rows may also bound the offset x itself (the
+// shift cap, the legs' reach). The hinge is solved by Gauss-Newton on its
+// active rows (exact for a piecewise quadratic: it stops when the active set
+// repeats). Only the first jerk is applied; the plan is made again next frame.
 //
-// Everything is sized at construction; solve() allocates nothing.
+// Everything is sized at construction; step() allocates nothing.
 #pragma once
 
 #include <Eigen/Cholesky>
@@ -35,12 +37,11 @@ class ConstrainedPreview {
   // `tail_cost`: the Riccati solution that prices the state beyond the
   // horizon. With the model's own P the first jerk with no rows is the
   // infinite-horizon regulator's; the online filter passes the P of a tracking
-  // weight Q + W, since beyond the horizon the last frame's rows hold and a
-  // violation there costs as much as within (with Q's P alone the plan pushes
-  // a held violation past the horizon, frame after frame, and runs away).
+  // weight Q + W / 4, since beyond the horizon a held demand still costs (with
+  // Q's P alone the plan pushes a held violation past the horizon, frame after
+  // frame, and runs away).
   ConstrainedPreview(const PreviewModel& model, const Eigen::Matrix3d& tail_cost, std::size_t horizon,
-                     double tracking_weight, double jerk_weight, double offset_weight, double violation_weight,
-                     std::size_t rows_per_frame);
+                     double tracking_weight, double jerk_weight, double violation_weight, std::size_t rows_per_frame);
 
   void clear_rows();
   // What a row bounds: the cart's ZMP move d, or its offset x (the centre of
@@ -79,7 +80,7 @@ class ConstrainedPreview {
   Eigen::MatrixXd g_;        // d_j = f_j s0 + g_j u (j = 1 .. n), per axis
   Eigen::MatrixXd f_;        // n x 3
   Eigen::MatrixXd gx_, fx_;  // the offset x_j likewise
-  Eigen::MatrixXd base_;     // Q G'G + R I + Gn' P Gn (n x n), the same for both axes
+  Eigen::MatrixXd base_;     // Q G'G + R I + Gn' P Gn (n x n; G over steps 1 .. n - 1), the same for both axes
   Eigen::MatrixXd base_f_;   // Q G'F + Gn' P An (n x 3): the gradient's part from s0
   Eigen::VectorXd tail_;     // Gn' P e1 (n): the gradient's part from the rest offset
   Eigen::MatrixXd system_;   // 2n x 2n

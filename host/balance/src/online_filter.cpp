@@ -15,16 +15,14 @@ namespace {
 constexpr double kMaxDrop_m = 0.008;
 // The least weight of a frame's ZMP error (its support ratio, below).
 constexpr double kMinErrorWeight = 0.2;
-// The most rows one frame gives the planner: its support polygon's edges (up
-// to 12; a hull of two soles has eight corners), the shift cap's 4 and the
-// legs' 2. More are dropped and counted by the planner.
+// The most rows one frame gives the planner: its support polygon's edges (at
+// most 12: each sole has two heel, two ball and two toe corners), the shift
+// cap's 4 and the legs' 2. More would be dropped and counted by the planner.
 constexpr std::size_t kRowsPerFrame = 18;
-// Each leg's hip, knee and ankle; kept from straightening beyond this share
-// of its length, as the waist correction keeps it (waist.cpp).
+// Each leg's hip, knee and ankle.
 constexpr std::array<std::array<std::size_t, 3>, 2> kLegJoints = {
     {{sim::index(sim::Bone::LeftUpperLeg), sim::index(sim::Bone::LeftLowerLeg), sim::index(sim::Bone::LeftFoot)},
      {sim::index(sim::Bone::RightUpperLeg), sim::index(sim::Bone::RightLowerLeg), sim::index(sim::Bone::RightFoot)}}};
-constexpr double kLegReach = 0.999;
 // Beyond the planner's horizon, what every frame of the look-ahead asks is
 // taken as held and priced by a Riccati cost-to-go of tracking weight Q + this
 // share of the violation weight (constrained_preview.hpp). Measured with the
@@ -126,9 +124,9 @@ OnlineBalance::OnlineBalance(const OnlineOptions& options, std::size_t lag, cons
   if (options.constraint_weight > 0.0) {
     const PreviewModel held =
         preview_model(preview_options(options, lag, 1.0 + kHeldShare * options.constraint_weight));
-    planner_ = std::make_unique<detail::ConstrainedPreview>(preview_, held.ok() ? held.P : preview_.P, lag, 1.0,
-                                                            options.jerk_weight, options.offset_weight,
-                                                            options.constraint_weight, kRowsPerFrame);
+    planner_ =
+        std::make_unique<detail::ConstrainedPreview>(preview_, held.ok() ? held.P : preview_.P, lag, 1.0,
+                                                     options.jerk_weight, options.constraint_weight, kRowsPerFrame);
   }
 }
 
@@ -319,7 +317,7 @@ void OnlineBalance::plan_rows(std::size_t w, std::size_t held) {
     const MotionFrame& f = frames_[k % (lag_ + 1)];
     for (const auto& leg : kLegJoints) {
       const Vec3 hip = f.p[leg[0]], knee = f.p[leg[1]], ankle = f.p[leg[2]];
-      const double reach = std::max(kLegReach * ((knee - hip).norm() + (ankle - knee).norm()), (ankle - hip).norm());
+      const double reach = leg_reach_m(hip, knee, ankle);
       const double height = std::max(hip.z() - ankle.z() - kMaxDrop_m, 0.0);
       const double across = std::sqrt(std::max(reach * reach - height * height, 0.0));
       const Vec2 out = (hip - ankle).head<2>();

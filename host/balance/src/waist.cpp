@@ -22,10 +22,6 @@ constexpr Bone kUpper[] = {Bone::Hips,      Bone::Spine,         Bone::Chest,   
 constexpr Landmark kUpperExtras[] = {Landmark::HeadTop, Landmark::LeftHandTip, Landmark::RightHandTip,
                                      Landmark::MidHip};
 
-// A leg is kept from straightening beyond this share of its length (the IK
-// keeps a sliver of knee bend rather than a singular straight leg).
-constexpr double kReach = 0.999;
-
 Quat exp_map(const Vec3& v) {
   const double a = v.norm();
   if (a < 1e-12) return Quat::Identity();
@@ -45,6 +41,11 @@ Vec3 at(const MotionFrame& f, Bone b) { return f.p[sim::index(b)]; }
 
 }  // namespace
 
+double leg_reach_m(const Vec3& hip, const Vec3& knee, const Vec3& ankle) {
+  constexpr double kReach = 0.999;
+  return std::max(kReach * ((knee - hip).norm() + (ankle - knee).norm()), (ankle - hip).norm());
+}
+
 Vec3 WaistTurn::ankle_target(const Vec3& ankle, std::size_t leg) const {
   return ankle + follow[leg] * (pivot + rotation * (ankle - pivot) + shift - Vec3(0, 0, drop_m) - ankle);
 }
@@ -59,14 +60,13 @@ WaistTurn waist_turn(const MotionFrame& in, const Vec3& delta, const Vec2& shift
   w.shift = Vec3(shift_m.x(), shift_m.y(), 0.0);
   w.follow = follow;
   // The vertical shift of the pelvis, closest to none, that keeps both hips
-  // within kReach of their legs' lengths from their ankles: each leg allows an
+  // within reach of their ankles (leg_reach_m): each leg allows an
   // interval of shifts; take the common one.
   double lo = -1e9, hi = 1e9;
   for (std::size_t li = 0; li < 2; ++li) {
     const Leg& leg = kLegs[li];
     const Vec3 hip = at(in, leg.thigh), knee = at(in, leg.shank), ankle = at(in, leg.ankle);
-    // As far as 99.9 % of the leg, or as far as the capture already has it (a kick's straight leg).
-    const double reach = std::max(kReach * ((knee - hip).norm() + (ankle - knee).norm()), (ankle - hip).norm());
+    const double reach = leg_reach_m(hip, knee, ankle);
     // Before any vertical shift s (up); a partly following foot rises with the
     // pelvis by its share, so the leg sees k s of it.
     if (w.follow[li] >= 1.0) continue;  // the leg moves rigidly with the pelvis

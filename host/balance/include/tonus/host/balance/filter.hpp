@@ -88,6 +88,11 @@ WaistTurn waist_turn(const MotionFrame& frame, const Vec3& delta, const Vec2& sh
 // rigidly, both legs re-solved by two-bone IK to keep their feet.
 MotionFrame rotate_waist(const MotionFrame& frame, const Vec3& delta, double* drop_m = nullptr,
                          bool* reachable = nullptr);
+// How far a hip joint may be from its ankle for the waist correction's
+// two-bone IK: 99.9 % of the leg (a sliver of knee bend rather than a singular
+// straight leg), or as far as the capture already has it (a kick's straight leg).
+double leg_reach_m(const Vec3& hip, const Vec3& knee, const Vec3& ankle);
+
 // The same with a horizontal pelvis shift after the turn.
 MotionFrame correct_waist(const MotionFrame& frame, const Vec3& delta, const Vec2& shift_m, double* drop_m = nullptr,
                           bool* reachable = nullptr, const std::array<double, 2>& follow = {});

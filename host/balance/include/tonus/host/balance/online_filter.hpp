@@ -68,8 +68,7 @@ struct OnlineOptions {
   // 0: Kajita's plain preview, one reference move per frame (what this filter
   // was until 2026-12-04; measured against the planner in docs/balance.md).
   double constraint_weight = 20.0;
-  double offset_weight = 0.0;  // with the planner: its centre-of-mass offset's weight, against the tracking's
-  double com_height_m = 0.9;   // the cart-table's height: the centre of mass above the ground, standing
+  double com_height_m = 0.9;  // the cart-table's height: the centre of mass above the ground, standing
 };
 
 // One corrected frame.
