@@ -126,26 +126,31 @@ TEST_CASE(
 }
 
 TEST_CASE("online balance filter: causal contacts agree with the offline detection on most foot-frames") {
-  for (const char* name : {"dataset-1_walk_normal_001.bvh", "dataset-1_kick_normal_001.bvh"}) {
-    const test::Loaded l = test::load(test::shared_clip(name));
+  // The CMU walk's floor rises 3 cm along the take, which the causal resting
+  // heights lag: 93.3 % before still feet counted as landed, 97.4 % after.
+  for (const auto& [path, least] : {std::pair{test::shared_clip("dataset-1_walk_normal_001.bvh"), 0.85},
+                                    std::pair{test::shared_clip("dataset-1_kick_normal_001.bvh"), 0.85},
+                                    std::pair{test::bundled_clip("cmu_02_walk.bvh"), 0.96}}) {
+    const std::string name = path.substr(path.find_last_of('/') + 1);
+    const test::Loaded l = test::load(path);
     const HumanMotion& m = l.conversion.motion;
     const ContactTrack offline = detect_contacts(m, {});
     CausalContacts causal({}, m.dt_s);
     std::size_t agree = 0, total = 0;
-    for (std::size_t t = 0; t < m.size(); ++t) {
+    for (std::size_t t = m.first_frame; t < m.size(); ++t) {
       const auto c = causal.push(m.frames[t]);
-      if (t < m.first_frame) continue;
       for (std::size_t f = 0; f < 2; ++f) {
         agree += c[f].any() == offline.frames[t][f].any();
         ++total;
       }
     }
     const double share = static_cast<double>(agree) / static_cast<double>(total);
-    MESSAGE(std::string(name) << ": causal and offline contacts agree on " << 100.0 * share
-                              << " % of foot-frames; ground " << causal.track().ground_z_m << " m (offline "
-                              << offline.ground_z_m << " m)");
-    CHECK(share > 0.85);
-    CHECK(std::abs(causal.track().ground_z_m - offline.ground_z_m) < 0.02);
+    MESSAGE(name << ": causal and offline contacts agree on " << 100.0 * share << " % of foot-frames; ground "
+                 << causal.track().ground_z_m << " m (offline " << offline.ground_z_m << " m)");
+    CHECK(share > least);
+    // The ground: within 2 cm of the offline estimate (where the floor rises,
+    // the CMU walk, the causal one is the last 1.5 s's, 3 cm above).
+    if (name != "cmu_02_walk.bvh") CHECK(std::abs(causal.track().ground_z_m - offline.ground_z_m) < 0.02);
   }
 }
 
@@ -170,8 +175,8 @@ TEST_CASE("online balance filter: the Bandai walk has fewer frames outside under
 }
 
 TEST_CASE("online balance filter: the fine layer takes capture jitter out, which the 12 Hz estimators see") {
-  // CMU walk, 12 Hz particle: 226 before; 218 after without the fine layer,
-  // 86 with it (measured 2026-12-05, with the planner).
+  // CMU walk, 12 Hz particle: 226 before; 213 after without the fine layer,
+  // 82 with it (measured 2026-12-05, with the planner).
   const test::Loaded l = test::load(test::bundled_clip("cmu_02_walk.bvh"));
   const HumanMotion& m = l.conversion.motion;
   OnlineOptions o = options_for(m);

@@ -124,6 +124,9 @@ Vec3 mean(const std::vector<Vec3>& v) {
 // heights within +-kRestWindow_s, so a floor that is not quite level (a take
 // whose stance foot creeps up a few centimetres) is followed.
 constexpr double kRestWindow_s = 1.5;
+// Causal detection: how long a point of a foot that is up must stand still to
+// count as landed even above its height threshold.
+constexpr double kStillLanded_s = 0.05;
 
 std::vector<double> resting_height(const std::vector<double>& height, std::size_t first, double dt) {
   const auto half = static_cast<std::size_t>(kRestWindow_s / dt);
@@ -301,8 +304,16 @@ std::array<FootContact, 2> CausalContacts::push(const MotionFrame& frame) {
       const double v = pushed_ > 2 ? (now[k] - p.before_last).norm() / (2.0 * dt_s_)
                                    : (pushed_ > 1 ? (now[k] - p.last).norm() / dt_s_ : 0.0);
       const double h = now[k].z() - rest;
+      // A foot with no point down whose point has stood still for a while,
+      // a little higher than its resting height (a floor that rises along the
+      // take, which the past 1.5 s cannot know), has landed: a swing foot
+      // is never still.
+      p.still = v < options_.speed_on_mps ? p.still + 1 : 0;
+      const bool foot_up = !points_[fi][0].on && !points_[fi][1].on;
+      const bool landed =
+          foot_up && static_cast<double>(p.still) * dt_s_ >= kStillLanded_s && h < options_.height_off_m;
       p.on = p.on ? !(h > options_.height_off_m || v > options_.speed_off_mps)
-                  : (h < options_.height_on_m && v < options_.speed_on_mps);
+                  : ((h < options_.height_on_m && v < options_.speed_on_mps) || landed);
       p.before_last = p.last;
       p.last = now[k];
       on[k] = p.on;

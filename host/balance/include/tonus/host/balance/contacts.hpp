@@ -71,7 +71,11 @@ Sole measure_sole(const MotionFrame& frame, Foot foot, double ground_z, const Co
 // sole), each point's resting height the 5th percentile of its own heights
 // over the last 1.5 s, speeds backward differences over two frames (one frame
 // late), and each sole is measured again whenever its foot stands flatter than
-// it has so far (low and slow), so it settles at the first flat stance.
+// it has so far (low and slow), so it settles at the first flat stance. One
+// rule the offline detection does not need: a point of a foot that is up,
+// still for 50 ms and under the `off` height, lands (on a floor that rises
+// along the take, the past 1.5 s put the resting height too low: the CMU
+// walk's left forefoot stood 16 frames 0.8 mm over the threshold).
 // Its storage is sized once (1.5 s of frames); push allocates only when it
 // measures a sole again.
 class CausalContacts {
@@ -87,6 +91,7 @@ class CausalContacts {
   struct Point {
     std::vector<double> heights;  // ring over the window
     Vec3 last = Vec3::Zero(), before_last = Vec3::Zero();
+    std::size_t still = 0;  // frames in a row slower than speed_on
     bool on = false;
   };
   [[nodiscard]] double percentile_of(const std::vector<double>& ring) const;
