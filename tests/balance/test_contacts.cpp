@@ -65,3 +65,27 @@ TEST_CASE("contacts: one-leg kicks stand on the left foot, jumps fly about a fif
   CHECK(jumps.airborne > jumps.frames / 8);  // about 20 % (SOURCES.md)
   CHECK(jumps.airborne < jumps.frames / 3);
 }
+
+TEST_CASE("contacts: a leading T-pose is nobody's neighbour: the contacts after it are as without it") {
+  // The CMU walk starts with a T-pose frame, 5 cm lower and elsewhere; a
+  // central difference across it made the first frame of motion a flight.
+  const test::Loaded l = test::load(test::bundled_clip("cmu_02_walk.bvh"));
+  const HumanMotion& m = l.conversion.motion;
+  REQUIRE(m.first_frame == 1);
+  HumanMotion without = m;
+  without.frames.erase(without.frames.begin());
+  without.first_frame = 0;
+  const ContactTrack with_tpose = detect_contacts(m, ContactOptions{});
+  const ContactTrack alone = detect_contacts(without, ContactOptions{});
+  std::size_t same = 0;
+  for (std::size_t t = 1; t < m.size(); ++t) {
+    for (std::size_t f = 0; f < 2; ++f) {
+      same += with_tpose.frames[t][f].heel == alone.frames[t - 1][f].heel &&
+              with_tpose.frames[t][f].ball == alone.frames[t - 1][f].ball;
+    }
+  }
+  CHECK(same == 2 * (m.size() - 1));
+  CHECK(with_tpose.frames[1][1].any());  // the right forefoot is down as the take starts
+  CHECK_FALSE(with_tpose.frames[0][0].any());
+  CHECK_FALSE(with_tpose.frames[0][1].any());
+}

@@ -142,10 +142,10 @@ std::vector<double> resting_height(const std::vector<double>& height, std::size_
 
 // Low-and-slow with hysteresis over a series of heights and speeds.
 std::vector<bool> hysteresis(const std::vector<double>& height, const std::vector<double>& speed,
-                             const std::vector<double>& rest, const ContactOptions& o) {
+                             const std::vector<double>& rest, std::size_t first, const ContactOptions& o) {
   std::vector<bool> on(height.size(), false);
   bool state = false;
-  for (std::size_t t = 0; t < height.size(); ++t) {
+  for (std::size_t t = first; t < height.size(); ++t) {
     const double h = height[t] - rest[t];
     if (state) {
       state = !(h > o.height_off_m || speed[t] > o.speed_off_mps);
@@ -162,7 +162,7 @@ std::vector<bool> hysteresis(const std::vector<double>& height, const std::vecto
 ContactTrack detect_contacts(const HumanMotion& m, const ContactOptions& opt) {
   ContactTrack track;
   track.frames.assign(m.size(), {});
-  if (m.size() < 3) return track;
+  if (m.size() < m.first_frame + 3) return track;
   // Ground: just below the lowest tracked foot points when they rest.
   if (opt.ground_z_m) {
     track.ground_z_m = *opt.ground_z_m;
@@ -188,10 +188,13 @@ ContactTrack detect_contacts(const HumanMotion& m, const ContactOptions& opt) {
       heel[t] = mean(w.rear);
       ball[t] = mean(w.ball);
     }
+    // Central differences within the motion; a leading T-pose is not a
+    // neighbour (the first frame after it takes the next one's speed).
     const auto speeds = [&](const std::vector<Vec3>& p) {
       std::vector<double> v(p.size(), 0.0);
-      for (std::size_t t = 1; t + 1 < p.size(); ++t) v[t] = (p[t + 1] - p[t - 1]).norm() / (2.0 * m.dt_s);
-      v.front() = v[1];
+      const std::size_t lo = m.first_frame + 1;
+      for (std::size_t t = lo; t + 1 < p.size(); ++t) v[t] = (p[t + 1] - p[t - 1]).norm() / (2.0 * m.dt_s);
+      for (std::size_t t = 0; t < lo; ++t) v[t] = v[lo];
       v.back() = v[v.size() - 2];
       return v;
     };
@@ -201,8 +204,10 @@ ContactTrack detect_contacts(const HumanMotion& m, const ContactOptions& opt) {
       return h;
     };
     const std::vector<double> hh = heights(heel), hb = heights(ball);
-    const std::vector<bool> heel_on = hysteresis(hh, speeds(heel), resting_height(hh, m.first_frame, m.dt_s), opt);
-    const std::vector<bool> ball_on = hysteresis(hb, speeds(ball), resting_height(hb, m.first_frame, m.dt_s), opt);
+    const std::vector<bool> heel_on =
+        hysteresis(hh, speeds(heel), resting_height(hh, m.first_frame, m.dt_s), m.first_frame, opt);
+    const std::vector<bool> ball_on =
+        hysteresis(hb, speeds(ball), resting_height(hb, m.first_frame, m.dt_s), m.first_frame, opt);
     for (std::size_t t = 0; t < m.size(); ++t) track.frames[t][fi] = {heel_on[t], ball_on[t]};
   }
   return track;
