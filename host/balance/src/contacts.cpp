@@ -124,9 +124,9 @@ Vec3 mean(const std::vector<Vec3>& v) {
 // heights within +-kRestWindow_s, so a floor that is not quite level (a take
 // whose stance foot creeps up a few centimetres) is followed.
 constexpr double kRestWindow_s = 1.5;
-// Causal detection: how long a point of a foot that is up must stand still to
-// count as landed even above its height threshold.
+// How long a point must stand still to land above its `on` height (below).
 constexpr double kStillLanded_s = 0.05;
+constexpr double kFlatFoot_m = 0.01;  // a still foot's heel and ball this close in height stand flat
 
 std::vector<double> resting_height(const std::vector<double>& height, std::size_t first, double dt) {
   const auto half = static_cast<std::size_t>(kRestWindow_s / dt);
@@ -140,21 +140,57 @@ std::vector<double> resting_height(const std::vector<double>& height, std::size_
   return rest;
 }
 
-// Low-and-slow with hysteresis over a series of heights and speeds.
-std::vector<bool> hysteresis(const std::vector<double>& height, const std::vector<double>& speed,
-                             const std::vector<double>& rest, std::size_t first, const ContactOptions& o) {
-  std::vector<bool> on(height.size(), false);
-  bool state = false;
-  for (std::size_t t = first; t < height.size(); ++t) {
-    const double h = height[t] - rest[t];
-    if (state) {
-      state = !(h > o.height_off_m || speed[t] > o.speed_off_mps);
-    } else {
-      state = h < o.height_on_m && speed[t] < o.speed_on_mps;
+// One point's series over the clip, and the frames within a run of still
+// frames (slower than speed_on) at least kStillLanded_s long.
+struct PointSeries {
+  std::vector<double> height, speed, rest;
+  std::vector<bool> still;
+};
+
+// Whether a point that is up lands although above its `on` height: still for
+// kStillLanded_s and under its `off` height, and its foot otherwise up, or its
+// foot's other point also still at the same height (a flat foot on a floor
+// higher than the resting heights say: a floor that rises along the take).
+bool lands_still(double h, bool still, double other_h, bool other_still, bool foot_up, const ContactOptions& o) {
+  if (!still || h >= o.height_off_m) return false;
+  return foot_up || (other_still && std::abs(h - other_h) < kFlatFoot_m);
+}
+
+// Low-and-slow with hysteresis over the heel's and the ball's series, with
+// the still-landing rule above.
+std::array<std::vector<bool>, 2> foot_hysteresis(const std::array<PointSeries, 2>& pts, std::size_t first,
+                                                 const ContactOptions& o) {
+  const std::size_t n = pts[0].height.size();
+  std::array<std::vector<bool>, 2> on{std::vector<bool>(n, false), std::vector<bool>(n, false)};
+  std::array<bool, 2> state{false, false};
+  for (std::size_t t = first; t < n; ++t) {
+    const bool foot_up = !state[0] && !state[1];
+    const std::array<double, 2> h{pts[0].height[t] - pts[0].rest[t], pts[1].height[t] - pts[1].rest[t]};
+    for (std::size_t k = 0; k < 2; ++k) {
+      const PointSeries& p = pts[k];
+      if (state[k]) {
+        state[k] = !(h[k] > o.height_off_m || p.speed[t] > o.speed_off_mps);
+      } else {
+        state[k] = (h[k] < o.height_on_m && p.speed[t] < o.speed_on_mps) ||
+                   lands_still(h[k], p.still[t], h[1 - k], pts[1 - k].still[t], foot_up, o);
+      }
+      on[k][t] = state[k];
     }
-    on[t] = state;
   }
   return on;
+}
+
+std::vector<bool> still_runs(const std::vector<double>& speed, std::size_t first, double dt, const ContactOptions& o) {
+  std::vector<bool> still(speed.size(), false);
+  const auto need = static_cast<std::size_t>(std::ceil(kStillLanded_s / dt - 1e-9));
+  for (std::size_t t = first; t < speed.size();) {
+    std::size_t e = t;
+    while (e < speed.size() && speed[e] < o.speed_on_mps) ++e;
+    if (e - t >= need)
+      std::fill(still.begin() + static_cast<std::ptrdiff_t>(t), still.begin() + static_cast<std::ptrdiff_t>(e), true);
+    t = e == t ? t + 1 : e;
+  }
+  return still;
 }
 
 }  // namespace
@@ -203,12 +239,16 @@ ContactTrack detect_contacts(const HumanMotion& m, const ContactOptions& opt) {
       for (std::size_t t = 0; t < p.size(); ++t) h[t] = p[t].z();
       return h;
     };
-    const std::vector<double> hh = heights(heel), hb = heights(ball);
-    const std::vector<bool> heel_on =
-        hysteresis(hh, speeds(heel), resting_height(hh, m.first_frame, m.dt_s), m.first_frame, opt);
-    const std::vector<bool> ball_on =
-        hysteresis(hb, speeds(ball), resting_height(hb, m.first_frame, m.dt_s), m.first_frame, opt);
-    for (std::size_t t = 0; t < m.size(); ++t) track.frames[t][fi] = {heel_on[t], ball_on[t]};
+    std::array<PointSeries, 2> pts;
+    for (std::size_t k = 0; k < 2; ++k) {
+      const std::vector<Vec3>& p = k == 0 ? heel : ball;
+      pts[k].height = heights(p);
+      pts[k].speed = speeds(p);
+      pts[k].rest = resting_height(pts[k].height, m.first_frame, m.dt_s);
+      pts[k].still = still_runs(pts[k].speed, m.first_frame, m.dt_s, opt);
+    }
+    const auto on = foot_hysteresis(pts, m.first_frame, opt);
+    for (std::size_t t = 0; t < m.size(); ++t) track.frames[t][fi] = {on[0][t], on[1][t]};
   }
   return track;
 }
@@ -301,24 +341,23 @@ std::array<FootContact, 2> CausalContacts::push(const MotionFrame& frame) {
     const Quat foot_rot = foot_rotation(frame, foot);
     const std::array<Vec3, 2> now = {Vec3(ankle + foot_rot * mean(track_.soles[fi].rear)),
                                      Vec3(ankle + foot_rot * mean(track_.soles[fi].ball))};
-    std::array<bool, 2> on{};
+    std::array<double, 2> h{}, v{};
     for (std::size_t k = 0; k < 2; ++k) {
       Point& p = points_[fi][k];
       p.heights[slot] = now[k].z();
-      const double rest = percentile_of(p.heights);
-      const double v = pushed_ > 2 ? (now[k] - p.before_last).norm() / (2.0 * dt_s_)
-                                   : (pushed_ > 1 ? (now[k] - p.last).norm() / dt_s_ : 0.0);
-      const double h = now[k].z() - rest;
-      // A foot with no point down whose point has stood still for a while,
-      // a little higher than its resting height (a floor that rises along the
-      // take, which the past 1.5 s cannot know), has landed: a swing foot
-      // is never still.
-      p.still = v < options_.speed_on_mps ? p.still + 1 : 0;
-      const bool foot_up = !points_[fi][0].on && !points_[fi][1].on;
-      const bool landed =
-          foot_up && static_cast<double>(p.still) * dt_s_ >= kStillLanded_s && h < options_.height_off_m;
-      p.on = p.on ? !(h > options_.height_off_m || v > options_.speed_off_mps)
-                  : ((h < options_.height_on_m && v < options_.speed_on_mps) || landed);
+      h[k] = now[k].z() - percentile_of(p.heights);
+      v[k] = pushed_ > 2 ? (now[k] - p.before_last).norm() / (2.0 * dt_s_)
+                         : (pushed_ > 1 ? (now[k] - p.last).norm() / dt_s_ : 0.0);
+      p.still = v[k] < options_.speed_on_mps ? p.still + 1 : 0;
+    }
+    const bool foot_up = !points_[fi][0].on && !points_[fi][1].on;
+    std::array<bool, 2> on{};
+    for (std::size_t k = 0; k < 2; ++k) {
+      Point& p = points_[fi][k];
+      const auto still = [&](const Point& q) { return static_cast<double>(q.still) * dt_s_ >= kStillLanded_s; };
+      const bool landed = lands_still(h[k], still(p), h[1 - k], still(points_[fi][1 - k]), foot_up, options_);
+      p.on = p.on ? !(h[k] > options_.height_off_m || v[k] > options_.speed_off_mps)
+                  : ((h[k] < options_.height_on_m && v[k] < options_.speed_on_mps) || landed);
       p.before_last = p.last;
       p.last = now[k];
       on[k] = p.on;

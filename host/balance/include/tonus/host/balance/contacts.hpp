@@ -3,10 +3,15 @@
 // Each foot has two contact points, the heel and the ball (the toe joint),
 // each in contact while it is low and slow, with hysteresis (it enters below
 // the `on` thresholds and leaves above the `off` ones) so a foot does not
-// flicker. The sole is a polygon fixed to the foot, measured once from the
-// frame where the foot stands flat; in contact, the part of the sole under the
-// touching points supports: the whole sole, the forefoot (heel off) or the
-// rear foot (heel strike). The support polygon is the convex hull of the
+// flicker. A point that has stood still for 50 ms also lands anywhere under
+// its `off` height when its foot is otherwise up, or when the foot's other
+// point stands as still at the same height (within 1 cm): a flat foot on a
+// floor higher than the point's resting height says (the CMU walk's floor
+// rises 3 cm along the take; its feet stood flat for 0.25 s with the ball
+// 2.4 cm up, and the ZMP over it, taken as a heel alone). A swing foot is
+// never still, and a raised heel is not level with its ball. The sole is a polygon fixed to the foot, measured once
+// from the frame where the foot stands flat; in contact, the part of the sole under the touching points supports: the
+// whole sole, the forefoot (heel off) or the rear foot (heel strike). The support polygon is the convex hull of the
 // supporting parts of both feet; a frame with neither foot down is airborne.
 #pragma once
 
@@ -71,11 +76,11 @@ Sole measure_sole(const MotionFrame& frame, Foot foot, double ground_z, const Co
 // sole), each point's resting height the 5th percentile of its own heights
 // over the last 1.5 s, speeds backward differences over two frames (one frame
 // late), and each sole is measured again whenever its foot stands flatter than
-// it has so far (low and slow), so it settles at the first flat stance. One
-// rule the offline detection does not need: a point of a foot that is up,
-// still for 50 ms and under the `off` height, lands (on a floor that rises
-// along the take, the past 1.5 s put the resting height too low: the CMU
-// walk's left forefoot stood 16 frames 0.8 mm over the threshold).
+// it has so far (low and slow), so it settles at the first flat stance. The
+// still-landing rule as offline, over the last 50 ms (a floor that rises
+// along the take matters more here: the past 1.5 s alone put the resting
+// height too low, and the CMU walk's left forefoot stood 16 frames 0.8 mm
+// over the threshold).
 // Its storage is sized once (1.5 s of frames); push allocates only when it
 // measures a sole again.
 class CausalContacts {
