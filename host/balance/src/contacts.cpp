@@ -198,7 +198,7 @@ std::vector<bool> still_runs(const std::vector<double>& speed, std::size_t first
 ContactTrack detect_contacts(const HumanMotion& m, const ContactOptions& opt) {
   ContactTrack track;
   track.frames.assign(m.size(), {});
-  if (m.size() < m.first_frame + 3) return track;
+  if (m.size() < 3 || m.size() <= m.first_frame) return track;
   // Ground: just below the lowest tracked foot points when they rest.
   if (opt.ground_z_m) {
     track.ground_z_m = *opt.ground_z_m;
@@ -224,14 +224,19 @@ ContactTrack detect_contacts(const HumanMotion& m, const ContactOptions& opt) {
       heel[t] = mean(w.rear);
       ball[t] = mean(w.ball);
     }
-    // Central differences within the motion; a leading T-pose is not a
-    // neighbour (the first frame after it takes the next one's speed).
+    // Central differences within the motion, each end taking its neighbour's
+    // (two frames: the one difference); a leading T-pose is not a neighbour.
     const auto speeds = [&](const std::vector<Vec3>& p) {
       std::vector<double> v(p.size(), 0.0);
-      const std::size_t lo = m.first_frame + 1;
-      for (std::size_t t = lo; t + 1 < p.size(); ++t) v[t] = (p[t + 1] - p[t - 1]).norm() / (2.0 * m.dt_s);
+      const std::size_t lo = m.first_frame, hi = p.size() - 1;
+      if (hi - lo >= 2) {
+        for (std::size_t t = lo + 1; t < hi; ++t) v[t] = (p[t + 1] - p[t - 1]).norm() / (2.0 * m.dt_s);
+        v[lo] = v[lo + 1];
+        v[hi] = v[hi - 1];
+      } else if (hi > lo) {
+        v[lo] = v[hi] = (p[hi] - p[lo]).norm() / m.dt_s;
+      }
       for (std::size_t t = 0; t < lo; ++t) v[t] = v[lo];
-      v.back() = v[v.size() - 2];
       return v;
     };
     const auto heights = [&](const std::vector<Vec3>& p) {
