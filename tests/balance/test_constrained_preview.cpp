@@ -72,6 +72,40 @@ TEST_CASE("constrained preview: a held half-plane is met as its soft closed form
   CHECK(s[1].x() == doctest::Approx(-w * 0.07 / (1.0 + 2.0 * w)).epsilon(1e-3));
 }
 
+TEST_CASE("constrained preview: a frame's support ratio scales the row, not the offset's own move") {
+  // At rest the ZMP moves by the offset itself whatever the support ratio r
+  // (only the offset's acceleration is amplified, by 1 / r). The filter's
+  // rows bound r times the move: r x <= -r 0.05, least of Q x^2 + W (r x +
+  // r 0.05)^2 at x = -W r^2 0.05 / (Q + W r^2). (Dividing the cart's ZMP by r,
+  // the model before 2026-12-05, gives -W r 0.05 / (Q + W).)
+  const double w = 20.0, need = 0.05;
+  const PreviewModel m = model_at(1.0 / 120.0, 30);
+  for (const double r : {0.5, 2.0}) {
+    CAPTURE(r);
+    ConstrainedPreview plan(m, model_at(1.0 / 120.0, 30, 1.0 + w * r * r).P, 30, 1.0, 1e-6, w, 4);
+    std::array<Eigen::Vector3d, 2> s{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    for (int k = 0; k < 900; ++k) {
+      plan.clear_rows();
+      for (std::size_t j = 1; j <= plan.horizon(); ++j) {
+        plan.set_support_ratio(j, r);
+        REQUIRE(plan.add_row(j, Bounds::zmp, Eigen::Vector2d(0, 1), -r * need));
+      }
+      plan.step(s);
+    }
+    // Within 6 %: the cost beyond the horizon is a Riccati P on the cart's
+    // ZMP alone (exact where r = 1, above), while the rows mix in the offset
+    // (r = 0.5: -3.96 cm against -4.17, where the old form gives -2.38; r = 2:
+    // -4.93 against -4.94, the old form -9.52).
+    const double closed = -w * r * r * need / (1.0 + w * r * r);
+    const double old_form = -w * r * need / (1.0 + w);
+    MESSAGE("r = " << r << ": settled at " << s[1].x() << " m, closed form " << closed << ", the old form "
+                   << old_form);
+    CHECK(std::abs(s[1].x() - closed) < 0.06 * std::abs(closed));
+    CHECK(std::abs(s[1].x() - old_form) > 0.3 * std::abs(closed));
+    CHECK(std::abs(s[1].z()) < 1e-6);  // at rest
+  }
+}
+
 TEST_CASE("constrained preview: with the online filter's held cost (Q + W / 4) a held violation settles") {
   // online_filter.cpp prices the state beyond the horizon with a quarter of
   // the violation weight: the plan then settles within 2 % of the closed form

@@ -32,6 +32,7 @@ TEST_CASE("constrained preview: step allocates nothing") {
     for (std::size_t j = 1; j <= plan.horizon(); ++j) {
       // A square support 10 cm wide whose centre sways, so rows come and go.
       const double c = 0.08 * std::sin(0.05 * static_cast<double>(k + static_cast<int>(j)));
+      plan.set_support_ratio(j, 1.0 + 0.5 * std::cos(0.1 * static_cast<double>(k)));  // a bounce
       for (const Eigen::Vector2d& n : normals)
         plan.add_row(j, detail::ConstrainedPreview::Bounds::zmp, n, 0.05 + n.x() * c);
       plan.add_row(j, detail::ConstrainedPreview::Bounds::offset, Eigen::Vector2d(1, 0), 0.04);

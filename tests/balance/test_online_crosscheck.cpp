@@ -140,15 +140,17 @@ TEST_CASE("online balance filter, crosschecked: Bandai punches, fewer frames out
   CHECK(c.online_to_offline.max_m < 0.065);
 }
 
-TEST_CASE("online balance filter, crosschecked: Bandai run, within 2.4 cm RMS of offline" *
+TEST_CASE("online balance filter, crosschecked: Bandai run, fewer frames outside, within 3 cm RMS of offline" *
           tonus::test::heavy_under_sanitizers()) {
-  // 21 -> 18 of 35; 2.14 cm RMS, 3.9 max: flight phases leave few frames to
-  // correct (the plain preview: 21 and 3.73 / 6.8).
+  // 21 -> 15 of 35; 2.78 cm RMS, 4.4 max (2026-12-05, since the planner
+  // models the support ratio: at the landings the offset's acceleration moves
+  // the ZMP less than the cart-table says; 18 and 2.14 / 3.9 before): flight
+  // phases leave few frames to correct (the plain preview: 21 and 3.73 / 6.8).
   const Crosschecked c =
       crosscheck("Bandai run", test::shared_clip("dataset-2_run_normal_010.bvh"), indep::kCentimetre_m, 0);
-  CHECK(c.independent_after <= 20);
-  CHECK(c.online_to_offline.rms_m < 0.024);
-  CHECK(c.online_to_offline.max_m < 0.045);
+  CHECK(c.independent_after <= 17);
+  CHECK(c.online_to_offline.rms_m < 0.030);
+  CHECK(c.online_to_offline.max_m < 0.050);
 }
 
 TEST_CASE("online balance filter, crosschecked: Bandai waving, balanced throughout, left as it was" *

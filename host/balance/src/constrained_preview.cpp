@@ -77,12 +77,22 @@ ConstrainedPreview::ConstrainedPreview(const PreviewModel& model, const Eigen::M
   system_.setZero(2 * n, 2 * n);
   rhs_.setZero(2 * n);
   u_.setZero(2 * n);
-  for (Eigen::VectorXd* v : {&d0_x_, &d0_y_, &d_x_, &d_y_, &x0_x_, &x0_y_, &x_x_, &x_y_, &s_xx_, &s_xy_, &s_yy_, &e_x_,
-                             &e_y_, &o_xx_, &o_xy_, &o_yy_, &oe_x_, &oe_y_})
+  for (Eigen::VectorXd* v : {&d0_x_, &d0_y_, &d_x_,  &d_y_,  &x0_x_, &x0_y_, &x_x_,  &x_y_,  &h0_x_, &h0_y_, &h_x_,
+                             &h_y_,  &s_xx_, &s_xy_, &s_yy_, &e_x_,  &e_y_,  &o_xx_, &o_xy_, &o_yy_, &oe_x_, &oe_y_})
     v->setZero(n);
+  h_ = g_;
+  ratio_.setOnes(n);
 }
 
-void ConstrainedPreview::clear_rows() { std::fill(count_.begin(), count_.end(), std::size_t{0}); }
+void ConstrainedPreview::clear_rows() {
+  std::fill(count_.begin(), count_.end(), std::size_t{0});
+  ratio_.setOnes();
+}
+
+void ConstrainedPreview::set_support_ratio(std::size_t step, double ratio) {
+  if (step < 1 || step > n_ || !(ratio > 0.0) || !std::isfinite(ratio)) return;
+  ratio_(static_cast<Eigen::Index>(step - 1)) = ratio;
+}
 
 bool ConstrainedPreview::add_row(std::size_t step, Bounds what, const Eigen::Vector2d& normal, double bound) {
   if (step < 1 || step > n_) return false;
@@ -116,8 +126,8 @@ void ConstrainedPreview::add_gram(const Eigen::MatrixXd& g, const Eigen::VectorX
 }
 
 // The soft optimum of one frame's rows at rest: the least of
-// Q |x|^2 + W sum max(0, n . x - h)^2 (at rest the cart's ZMP is its offset,
-// so both kinds of row bound it alike).
+// Q |x|^2 + W sum max(0, n . x - h)^2 (at rest the cart's ZMP is its offset;
+// a zmp row bounds it times the frame's support ratio).
 Eigen::Vector2d ConstrainedPreview::frame_rest(std::size_t j) const {
   Eigen::Vector2d x = Eigen::Vector2d::Zero();
   for (int pass = 0; pass < kMaxPasses; ++pass) {
@@ -125,9 +135,12 @@ Eigen::Vector2d ConstrainedPreview::frame_rest(std::size_t j) const {
     Eigen::Vector2d g = Eigen::Vector2d::Zero();
     for (std::size_t k = 0; k < count_[j]; ++k) {
       const Row& row = rows_[j * per_frame_ + k];
-      if (row.normal.dot(x) <= row.bound) continue;
-      h += weight_ * row.normal * row.normal.transpose();
-      g += weight_ * row.normal * row.bound;
+      // At rest a zmp row bounds r x (d = x), an offset row x.
+      const Eigen::Vector2d normal =
+          row.what == Bounds::zmp ? Eigen::Vector2d(ratio_(static_cast<Eigen::Index>(j)) * row.normal) : row.normal;
+      if (normal.dot(x) <= row.bound) continue;
+      h += weight_ * normal * normal.transpose();
+      g += weight_ * normal * row.bound;
     }
     const Eigen::Vector2d next = h.ldlt().solve(g);
     const bool settled = (next - x).norm() < 1e-12;
@@ -159,6 +172,13 @@ int ConstrainedPreview::step(std::array<Eigen::Vector3d, 2>& state) {
   d0_y_.noalias() = f_ * state[1];
   x0_x_.noalias() = fx_ * state[0];
   x0_y_.noalias() = fx_ * state[1];
+  // What the zmp rows bound: d - (1 - r) x, frame by frame.
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double c = 1.0 - ratio_(j);
+    h_.row(j) = g_.row(j) - c * gx_.row(j);
+    h0_x_(j) = d0_x_(j) - c * x0_x_(j);
+    h0_y_(j) = d0_y_(j) - c * x0_y_(j);
+  }
   // Warm start: last frame's plan, one frame on.
   for (Eigen::Index i = 0; i + 1 < n; ++i) {
     u_(i) = u_(i + 1);
@@ -177,6 +197,10 @@ int ConstrainedPreview::step(std::array<Eigen::Vector3d, 2>& state) {
     x_x_ += x0_x_;
     x_y_.noalias() = gx_ * u_.tail(n);
     x_y_ += x0_y_;
+    h_x_.noalias() = h_ * u_.head(n);
+    h_x_ += h0_x_;
+    h_y_.noalias() = h_ * u_.tail(n);
+    h_y_ += h0_y_;
     bool same = pass > 0;
     for (Eigen::Index j = 0; j < n; ++j) {
       std::array<double, 5> zs{}, os{};  // xx, xy, yy, ex, ey
@@ -185,13 +209,13 @@ int ConstrainedPreview::step(std::array<Eigen::Vector3d, 2>& state) {
         const std::size_t idx = ju * per_frame_ + k;
         const Row& row = rows_[idx];
         const bool zmp = row.what == Bounds::zmp;
-        const double vx = zmp ? d_x_(j) : x_x_(j), vy = zmp ? d_y_(j) : x_y_(j);
+        const double vx = zmp ? h_x_(j) : x_x_(j), vy = zmp ? h_y_(j) : x_y_(j);
         const unsigned char on = row.normal.x() * vx + row.normal.y() * vy > row.bound ? 1 : 0;
         same = same && on == previous_[idx];
         active_[idx] = on;
         if (on == 0) continue;
         std::array<double, 5>& sum = zmp ? zs : os;
-        const double v0x = zmp ? d0_x_(j) : x0_x_(j), v0y = zmp ? d0_y_(j) : x0_y_(j);
+        const double v0x = zmp ? h0_x_(j) : x0_x_(j), v0y = zmp ? h0_y_(j) : x0_y_(j);
         const double c = row.normal.x() * v0x + row.normal.y() * v0y - row.bound;
         sum[0] += row.normal.x() * row.normal.x();
         sum[1] += row.normal.x() * row.normal.y();
@@ -215,7 +239,7 @@ int ConstrainedPreview::step(std::array<Eigen::Vector3d, 2>& state) {
     system_.topLeftCorner(n, n) = base_;
     system_.bottomRightCorner(n, n) = base_;
     system_.topRightCorner(n, n).setZero();
-    add_gram(g_, s_xx_, s_xy_, s_yy_);
+    add_gram(h_, s_xx_, s_xy_, s_yy_);
     add_gram(gx_, o_xx_, o_xy_, o_yy_);
     // Products one at a time, each straight into rhs_ (a product inside a
     // sum would be evaluated into a temporary on the heap).
@@ -223,8 +247,8 @@ int ConstrainedPreview::step(std::array<Eigen::Vector3d, 2>& state) {
     rhs_.tail(n) = tail_ * rest.y();
     rhs_.head(n).noalias() -= base_f_ * state[0];
     rhs_.tail(n).noalias() -= base_f_ * state[1];
-    rhs_.head(n).noalias() -= g_.transpose() * e_x_;
-    rhs_.tail(n).noalias() -= g_.transpose() * e_y_;
+    rhs_.head(n).noalias() -= h_.transpose() * e_x_;
+    rhs_.tail(n).noalias() -= h_.transpose() * e_y_;
     rhs_.head(n).noalias() -= gx_.transpose() * oe_x_;
     rhs_.tail(n).noalias() -= gx_.transpose() * oe_y_;
     if (!factor_upper(system_)) {  // cannot happen with a positive jerk weight; keep the last plan

@@ -50,6 +50,13 @@ class ConstrainedPreview {
   // At `step` frames ahead (1 .. horizon): normal . (d or x) <= bound. False
   // (the row dropped, counted) when the frame is full.
   bool add_row(std::size_t step, Bounds what, const Eigen::Vector2d& normal, double bound);
+  // The frame's support ratio r (its vertical force over the weight; 1 until
+  // set, and again after clear_rows). A centre-of-mass offset x moves the ZMP
+  // by x - z_c / g * xdd / r: the offset itself is not amplified where the
+  // feet carry part of the weight, its acceleration is. The frame's zmp rows
+  // then bound r times that move, n . (d - (1 - r) x) <= bound (d = x -
+  // z_c / g * xdd, the cart's ZMP), which is d itself where r = 1.
+  void set_support_ratio(std::size_t step, double ratio);
 
   // Plans from the two axes' states (x, xd, xdd each), applies the first jerk
   // and advances the states by one frame. Returns the Gauss-Newton passes made.
@@ -78,6 +85,8 @@ class ConstrainedPreview {
   double tracking_;
   std::size_t per_frame_;
   Eigen::MatrixXd g_;        // d_j = f_j s0 + g_j u (j = 1 .. n), per axis
+  Eigen::MatrixXd h_;        // what the zmp rows bound, d_j - (1 - r_j) x_j: g_ - (1 - r) gx_ (its u part)
+  Eigen::VectorXd ratio_;    // per frame, r_j
   Eigen::MatrixXd f_;        // n x 3
   Eigen::MatrixXd gx_, fx_;  // the offset x_j likewise
   Eigen::MatrixXd base_;     // Q G'G + R I + Gn' P Gn (n x n; G over steps 1 .. n - 1), the same for both axes
@@ -87,6 +96,8 @@ class ConstrainedPreview {
   Eigen::VectorXd rhs_, u_;  // 2n: u_ is the plan (x jerks, then y)
   // n each: the moves and offsets with no jerk, and with the plan.
   Eigen::VectorXd d0_x_, d0_y_, d_x_, d_y_, x0_x_, x0_y_, x_x_, x_y_;
+  // n each: what the zmp rows bound (d - (1 - r) x), with no jerk and with the plan.
+  Eigen::VectorXd h0_x_, h0_y_, h_x_, h_y_;
   // Per frame, over its active rows of each kind: W sum n n' (xx, xy, yy) and
   // W sum n (n . v0 - h).
   Eigen::VectorXd s_xx_, s_xy_, s_yy_, e_x_, e_y_, o_xx_, o_xy_, o_yy_, oe_x_, oe_y_;

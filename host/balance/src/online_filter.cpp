@@ -15,6 +15,9 @@ namespace {
 constexpr double kMaxDrop_m = 0.008;
 // The least weight of a frame's ZMP error (its support ratio, below).
 constexpr double kMinErrorWeight = 0.2;
+// The planner's support ratio: from that floor to this cap (a landing's
+// impact; at 2 or 6 the clips' counts are within 5 frames of 3's).
+constexpr double kMaxPlanRatio = 3.0;
 // The most rows one frame gives the planner: its support polygon's edges (at
 // most 12: each sole has two heel, two ball and two toe corners), the shift
 // cap's 4 and the legs' 2. More would be dropped and counted by the planner.
@@ -117,6 +120,7 @@ OnlineBalance::OnlineBalance(const OnlineOptions& options, std::size_t lag, cons
       window_(kSegmentParts * (lag + 1)),
       zmp_(lag + 1, Vec2::Zero()),
       weight_(lag + 1, 0.0),
+      ratio_(lag + 1, 1.0),
       outside_(lag + 1, 0.0),
       defined_(lag + 1, false) {
   errors_[0].assign(lag + 1, 0.0);
@@ -195,6 +199,7 @@ void OnlineBalance::window_errors() {
     errors_[0][w] = errors_[1][w] = 0.0;
     defined_[w] = valid && z.defined;
     weight_[w] = std::clamp(z.support_ratio, kMinErrorWeight, 1.0);
+    ratio_[w] = std::clamp(z.support_ratio, kMinErrorWeight, kMaxPlanRatio);
     zmp_[w] = z.zmp;
     outside_[w] = 0.0;
     const ConvexPolygon& poly = polygons_[k % (lag_ + 1)];
@@ -294,9 +299,11 @@ void OnlineBalance::emit(std::size_t frames_back, OnlineFrame& out) {
 }
 
 // The planner's half-planes for the frames after window position w: each
-// edge of a frame's support polygon bounds the cart's ZMP move d by
-// n . (z + d / weight) <= n . edge - margin (the move's weight as the error's:
-// where the feet carry part of the weight, a shift moves the ZMP further).
+// edge of a frame's support polygon bounds the ZMP's move m by
+// n . (z + m) <= n . edge - margin, m = x - z_c / g * xdd / r for the offset
+// x and the frame's support ratio r (where the feet carry part of the
+// weight, the offset's acceleration moves the ZMP further; at a landing's
+// impact, less), as r times it (ConstrainedPreview::set_support_ratio).
 // Beyond the newest frame the newest is held.
 void OnlineBalance::plan_rows(std::size_t w, std::size_t held) {
   using Bounds = detail::ConstrainedPreview::Bounds;
@@ -328,7 +335,10 @@ void OnlineBalance::plan_rows(std::size_t w, std::size_t held) {
     if (!defined_[pos]) continue;
     const ConvexPolygon& poly = polygons_[k % (lag_ + 1)];
     const Vec2 z = zmp_[pos];
-    const double weight = weight_[pos];
+    // The offset moves the ZMP by itself, its acceleration by z_c / g over
+    // the support ratio: the rows bound the ratio times that move.
+    const double ratio = ratio_[pos];
+    planner_->set_support_ratio(s, ratio);
     if (poly.vertices.size() >= 3) {
       for (std::size_t i = 0; i < poly.vertices.size(); ++i) {
         const Vec2& p0 = poly.vertices[i];
@@ -337,7 +347,7 @@ void OnlineBalance::plan_rows(std::size_t w, std::size_t held) {
         const double len = edge.norm();
         if (len < 1e-9) continue;
         const Vec2 normal(edge.y() / len, -edge.x() / len);  // outward: the vertices run counter-clockwise
-        const double bound = weight * (normal.dot(p0) - options_.margin_m - normal.dot(z));
+        const double bound = ratio * (normal.dot(p0) - options_.margin_m - normal.dot(z));
         if (bound < kFarEnough_m) planner_->add_row(s, Bounds::zmp, normal, bound);
       }
     } else if (!poly.vertices.empty()) {
@@ -345,7 +355,7 @@ void OnlineBalance::plan_rows(std::size_t w, std::size_t held) {
       const Vec2 target = nearest_point_inset(poly, z, options_.margin_m);
       const Vec2 away = z - target;
       const double dist = away.norm();
-      if (dist > 1e-9) planner_->add_row(s, Bounds::zmp, away / dist, -weight * dist);
+      if (dist > 1e-9) planner_->add_row(s, Bounds::zmp, away / dist, -ratio * dist);
     }
   }
 }
