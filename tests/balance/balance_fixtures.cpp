@@ -43,4 +43,11 @@ std::string column_name(const motion::Clip& clip, std::size_t column) {
   return "column " + std::to_string(column);
 }
 
+HumanMotion without_leading_tpose(const HumanMotion& m) {
+  HumanMotion cut = m;
+  cut.frames.erase(cut.frames.begin(), cut.frames.begin() + static_cast<std::ptrdiff_t>(m.first_frame));
+  cut.first_frame = 0;
+  return cut;
+}
+
 }  // namespace tonus::balance::test

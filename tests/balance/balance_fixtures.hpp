@@ -25,6 +25,8 @@ Loaded load(const std::string& path, const ConvertOptions& options = {});
 // frames differ by more than `degrees` (rotation channels; position columns
 // count zero).
 std::vector<std::size_t> rotation_jumps(const motion::Clip& clip, double degrees = 90.0);
+// The motion with its leading T-pose (the frames before first_frame) cut off.
+HumanMotion without_leading_tpose(const HumanMotion& m);
 // "Joint Channel" for a column of a frame row, for messages.
 std::string column_name(const motion::Clip& clip, std::size_t column);
 

@@ -72,11 +72,8 @@ TEST_CASE("contacts: a leading T-pose is nobody's neighbour: the contacts after 
   const test::Loaded l = test::load(test::bundled_clip("cmu_02_walk.bvh"));
   const HumanMotion& m = l.conversion.motion;
   REQUIRE(m.first_frame == 1);
-  HumanMotion without = m;
-  without.frames.erase(without.frames.begin());
-  without.first_frame = 0;
   const ContactTrack with_tpose = detect_contacts(m, ContactOptions{});
-  const ContactTrack alone = detect_contacts(without, ContactOptions{});
+  const ContactTrack alone = detect_contacts(test::without_leading_tpose(m), ContactOptions{});
   std::size_t same = 0;
   for (std::size_t t = 1; t < m.size(); ++t) {
     for (std::size_t f = 0; f < 2; ++f) {

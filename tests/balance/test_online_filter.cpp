@@ -214,12 +214,9 @@ TEST_CASE("online balance filter: a clip's leading T-pose is not streamed: it st
   const test::Loaded l = test::load(test::bundled_clip("cmu_02_walk.bvh"));
   const HumanMotion& m = l.conversion.motion;
   REQUIRE(m.first_frame == 1);
-  HumanMotion without_tpose = m;
-  without_tpose.frames.erase(without_tpose.frames.begin());
-  without_tpose.first_frame = 0;
   const OnlineOptions o = options_for(m);
   const OnlineRun with = run_online(m, o);
-  const OnlineRun without = run_online(without_tpose, o);
+  const OnlineRun without = run_online(test::without_leading_tpose(m), o);
   REQUIRE(with.ok());
   REQUIRE(with.corrected.size() == m.size());
   CHECK(same_bits(with.corrected.frames[0], m.frames[0]));
