@@ -77,8 +77,8 @@ ConstrainedPreview::ConstrainedPreview(const PreviewModel& model, const Eigen::M
   system_.setZero(2 * n, 2 * n);
   rhs_.setZero(2 * n);
   u_.setZero(2 * n);
-  for (Eigen::VectorXd* v : {&d0_x_, &d0_y_, &d_x_,  &d_y_,  &x0_x_, &x0_y_, &x_x_,  &x_y_,  &h0_x_, &h0_y_, &h_x_,
-                             &h_y_,  &s_xx_, &s_xy_, &s_yy_, &e_x_,  &e_y_,  &o_xx_, &o_xy_, &o_yy_, &oe_x_, &oe_y_})
+  for (Eigen::VectorXd* v : {&d0_x_, &d0_y_, &x0_x_, &x0_y_, &x_x_, &x_y_,  &h0_x_, &h0_y_, &h_x_,  &h_y_,
+                             &s_xx_, &s_xy_, &s_yy_, &e_x_,  &e_y_, &o_xx_, &o_xy_, &o_yy_, &oe_x_, &oe_y_})
     v->setZero(n);
   h_ = g_;
   ratio_.setOnes(n);
@@ -189,10 +189,6 @@ int ConstrainedPreview::step(std::array<Eigen::Vector3d, 2>& state) {
   const Eigen::Vector2d rest = rest_offset();
   int pass = 0;
   for (; pass < kMaxPasses; ++pass) {
-    d_x_.noalias() = g_ * u_.head(n);
-    d_x_ += d0_x_;
-    d_y_.noalias() = g_ * u_.tail(n);
-    d_y_ += d0_y_;
     x_x_.noalias() = gx_ * u_.head(n);
     x_x_ += x0_x_;
     x_y_.noalias() = gx_ * u_.tail(n);

@@ -94,8 +94,8 @@ class ConstrainedPreview {
   Eigen::VectorXd tail_;     // Gn' P e1 (n): the gradient's part from the rest offset
   Eigen::MatrixXd system_;   // 2n x 2n
   Eigen::VectorXd rhs_, u_;  // 2n: u_ is the plan (x jerks, then y)
-  // n each: the moves and offsets with no jerk, and with the plan.
-  Eigen::VectorXd d0_x_, d0_y_, d_x_, d_y_, x0_x_, x0_y_, x_x_, x_y_;
+  // n each: the cart's ZMP moves with no jerk, and the offsets with no jerk and with the plan.
+  Eigen::VectorXd d0_x_, d0_y_, x0_x_, x0_y_, x_x_, x_y_;
   // n each: what the zmp rows bound (d - (1 - r) x), with no jerk and with the plan.
   Eigen::VectorXd h0_x_, h0_y_, h_x_, h_y_;
   // Per frame, over its active rows of each kind: W sum n n' (xx, xy, yy) and
