@@ -156,6 +156,14 @@ bool lands_still(double h, bool still, double other_h, bool other_still, bool fo
   return foot_up || (other_still && std::abs(h - other_h) < kFlatFoot_m);
 }
 
+// A point's contact after this frame: it stays down until it rises above the
+// `off` height or moves faster than the `off` speed; it lands when low and
+// slow, or by the still-landing rule (`landed`, above). Offline and causal alike.
+bool next_contact(bool on, double h, double speed, bool landed, const ContactOptions& o) {
+  if (on) return !(h > o.height_off_m || speed > o.speed_off_mps);
+  return (h < o.height_on_m && speed < o.speed_on_mps) || landed;
+}
+
 // Low-and-slow with hysteresis over the heel's and the ball's series, with
 // the still-landing rule above.
 std::array<std::vector<bool>, 2> foot_hysteresis(const std::array<PointSeries, 2>& pts, std::size_t first,
@@ -168,12 +176,8 @@ std::array<std::vector<bool>, 2> foot_hysteresis(const std::array<PointSeries, 2
     const std::array<double, 2> h{pts[0].height[t] - pts[0].rest[t], pts[1].height[t] - pts[1].rest[t]};
     for (std::size_t k = 0; k < 2; ++k) {
       const PointSeries& p = pts[k];
-      if (state[k]) {
-        state[k] = !(h[k] > o.height_off_m || p.speed[t] > o.speed_off_mps);
-      } else {
-        state[k] = (h[k] < o.height_on_m && p.speed[t] < o.speed_on_mps) ||
-                   lands_still(h[k], p.still[t], h[1 - k], pts[1 - k].still[t], foot_up, o);
-      }
+      const bool landed = lands_still(h[k], p.still[t], h[1 - k], pts[1 - k].still[t], foot_up, o);
+      state[k] = next_contact(state[k], h[k], p.speed[t], landed, o);
       on[k][t] = state[k];
     }
   }
@@ -356,13 +360,12 @@ std::array<FootContact, 2> CausalContacts::push(const MotionFrame& frame) {
       p.still = v[k] < options_.speed_on_mps ? p.still + 1 : 0;
     }
     const bool foot_up = !points_[fi][0].on && !points_[fi][1].on;
+    const auto still = [&](const Point& q) { return static_cast<double>(q.still) * dt_s_ >= kStillLanded_s; };
     std::array<bool, 2> on{};
     for (std::size_t k = 0; k < 2; ++k) {
       Point& p = points_[fi][k];
-      const auto still = [&](const Point& q) { return static_cast<double>(q.still) * dt_s_ >= kStillLanded_s; };
       const bool landed = lands_still(h[k], still(p), h[1 - k], still(points_[fi][1 - k]), foot_up, options_);
-      p.on = p.on ? !(h[k] > options_.height_off_m || v[k] > options_.speed_off_mps)
-                  : ((h[k] < options_.height_on_m && v[k] < options_.speed_on_mps) || landed);
+      p.on = next_contact(p.on, h[k], v[k], landed, options_);
       p.before_last = p.last;
       p.last = now[k];
       on[k] = p.on;

@@ -9,10 +9,12 @@
 // floor higher than the point's resting height says (the CMU walk's floor
 // rises 3 cm along the take; its feet stood flat for 0.25 s with the ball
 // 2.4 cm up, and the ZMP over it, taken as a heel alone). A swing foot is
-// never still, and a raised heel is not level with its ball. The sole is a polygon fixed to the foot, measured once
-// from the frame where the foot stands flat; in contact, the part of the sole under the touching points supports: the
-// whole sole, the forefoot (heel off) or the rear foot (heel strike). The support polygon is the convex hull of the
-// supporting parts of both feet; a frame with neither foot down is airborne.
+// never still, and a raised heel is not level with its ball.
+// The sole is a polygon fixed to the foot, measured once from the frame where
+// the foot stands flat; in contact, the part of the sole under the touching
+// points supports: the whole sole, the forefoot (heel off) or the rear foot
+// (heel strike). The support polygon is the convex hull of the supporting
+// parts of both feet; a frame with neither foot down is airborne.
 #pragma once
 
 #include <optional>
