@@ -119,7 +119,6 @@ OnlineBalance::OnlineBalance(const OnlineOptions& options, std::size_t lag, cons
       polygons_(lag + 1),
       window_(kSegmentParts * (lag + 1)),
       zmp_(lag + 1, Vec2::Zero()),
-      weight_(lag + 1, 0.0),
       ratio_(lag + 1, 1.0),
       outside_(lag + 1, 0.0),
       defined_(lag + 1, false) {
@@ -198,7 +197,6 @@ void OnlineBalance::window_errors() {
     const ZmpResult z = zero_moment_point(mass_, zi, ground, g);
     errors_[0][w] = errors_[1][w] = 0.0;
     defined_[w] = valid && z.defined;
-    weight_[w] = std::clamp(z.support_ratio, kMinErrorWeight, 1.0);
     ratio_[w] = std::clamp(z.support_ratio, kMinErrorWeight, kMaxPlanRatio);
     zmp_[w] = z.zmp;
     outside_[w] = 0.0;
@@ -209,8 +207,9 @@ void OnlineBalance::window_errors() {
       const Vec2 target = nearest_point_inset(poly, z.zmp, options_.margin_m);
       // Where the feet carry only part of the weight (a bounce's trough), a
       // shift's acceleration moves the ZMP by the inverse of that share, and
-      // the estimators disagree most: the cart asks for the share of the move.
-      const double weight = weight_[w];
+      // the estimators disagree most: the cart asks for the share of the move
+      // (the plain preview's weight: the support ratio, at most 1).
+      const double weight = std::min(ratio_[w], 1.0);
       errors_[0][w] = weight * (target.x() - z.zmp.x());
       errors_[1][w] = weight * (target.y() - z.zmp.y());
     }

@@ -136,8 +136,7 @@ class OnlineBalance {
   // Per window position (0 = the oldest): the ZMP error ahead, per axis.
   std::array<std::vector<double>, 2> errors_;
   std::vector<Vec2> zmp_;
-  std::vector<double> weight_;  // per window position: the error's weight (support ratio, at most 1)
-  std::vector<double> ratio_;   // per window position: the support ratio the planner models (up to 3)
+  std::vector<double> ratio_;  // per window position: the support ratio, 0.2 to 3 (the errors' weight: at most 1)
   std::vector<double> outside_;
   std::vector<bool> defined_;
   double share_ = 0.0;  // of a pelvis shift, what the centre of mass follows (measured on the first frame out)
