@@ -7,7 +7,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <regex>
 #include <string>
+#include <vector>
 #include "support/read_file.hpp"
 #include "support/sanitized.hpp"
 
@@ -123,13 +125,31 @@ TEST_CASE("tonus zmp --online: the streaming filter, its look-ahead and cost in 
   const Run r = run(clip + " --online --lookahead 0.2 -o " + temp("online.bvh") + " --json " + temp("online.json"));
   INFO(r.out);
   CHECK(r.code == 1);  // not yet balanced under every estimator (docs/balance.md)
-  CHECK(r.out.find("correction (online, look-ahead 0.200 s = 24 frames): pelvis shift up to ") != std::string::npos);
+  CHECK(r.out.find("correction (online, look-ahead 0.200 s = 24 frames, window smoothing 10 Hz): pelvis shift up to ") !=
+        std::string::npos);
   CHECK(r.out.find("under each estimator") != std::string::npos);
   const std::string json = read_file(temp("online.json"));
   CHECK(json.find("\"online\": true") != std::string::npos);
   CHECK(json.find("\"lookahead_frames\": 24") != std::string::npos);
   CHECK(json.find("\"online_us_per_frame\": {\"mean\": ") != std::string::npos);
+  CHECK(json.find("\"online_window_cutoff_hz\": 10,") != std::string::npos);
   CHECK(run(clip + " --online --lookahead 0.3").code != 0);  // over the bound
+  CHECK(run(clip + " --online --window-cutoff 0").code != 0);
+  // The window's cut-off changes the correction, not the family that judges it.
+  const Run six = run(clip + " --online --lookahead 0.2 --window-cutoff 6 -o " + temp("online6.bvh"));
+  CHECK(six.out.find("window smoothing 6 Hz") != std::string::npos);
+  CHECK(read_file(temp("online6.bvh")) != read_file(temp("online.bvh")));
+  const auto befores = [](const std::string& out) {
+    std::vector<std::string> counts;
+    const std::string family = out.substr(std::min(out.find("under each estimator"), out.size()));
+    const std::regex before_count("(\\d+) -> ");
+    for (std::sregex_iterator i(family.begin(), family.end(), before_count), end; i != end; ++i) {
+      counts.push_back((*i)[1]);
+    }
+    return counts;
+  };
+  CHECK(befores(r.out).size() == 8);
+  CHECK(befores(six.out) == befores(r.out));
 }
 
 TEST_CASE("tonus zmp: bad input is refused with exit code 2 and a reason") {

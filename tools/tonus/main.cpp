@@ -66,7 +66,7 @@ int run(int argc, char** argv) {
   zmp_cmd->add_option("--contact-speed", zmp.contact_speed_mps, "... and slower than this, m/s")
       ->check(CLI::Range(0.01, 5.0));
   zmp_cmd->add_option("--derivative", zmp.derivative, "kalman_spline (default), kalman, spline or finite_difference");
-  zmp_cmd->add_option("--cutoff", zmp.cutoff_hz, "Smoothing cutoff, Hz")->check(CLI::Range(0.5, 100.0));
+  zmp_cmd->add_option("--cutoff", zmp.cutoff_hz, "The analysis's smoothing cutoff, Hz")->check(CLI::Range(0.5, 100.0));
   zmp_cmd->add_flag("--full-zmp", zmp.full_zmp, "Include the segments' angular momentum (default: particle form)");
   zmp_cmd
       ->add_option("--correction", zmp.correction,
@@ -84,6 +84,12 @@ int run(int argc, char** argv) {
                    "ZMP tracking (0: Kajita's plain preview, one reference move per frame)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1000.0));
+  zmp_cmd
+      ->add_option("--window-cutoff", zmp.window_cutoff_hz,
+                   "--online: the cutoff of the smoothing in the filter's window, Hz (the family that judges the "
+                   "result is unchanged)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.5, 100.0));
   zmp_cmd
       ->add_option(
           "--margin", zmp.margin_m,

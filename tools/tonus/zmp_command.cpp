@@ -124,6 +124,7 @@ bool online_result(const balance::HumanMotion& motion, const balance::AnalysisOp
   oo.lookahead_s = opt.lookahead_s;
   if (opt.margin_m > 0.0) oo.margin_m = opt.margin_m;  // else the filter's own, as tonusd runs it
   oo.constraint_weight = opt.plan_weight;
+  oo.window_cutoff_hz = opt.window_cutoff_hz;
   balance::OnlineRun run = balance::run_online(motion, oo);
   if (!run.ok()) {
     error = run.error;
@@ -272,6 +273,7 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
   report.online = opt.online;
   report.online_mean_us = online_cost_us[0];
   report.online_max_us = online_cost_us[1];
+  report.online_window_cutoff_hz = opt.window_cutoff_hz;
   report.forward = travel_direction(conv.motion, result.before);
   if (!opt.csv.empty() && !write_zmp_csv(opt.csv, report, error)) return fail(error);
   if (!opt.json.empty() && !write_zmp_json(opt.json, report, error)) return fail(error);
@@ -300,9 +302,9 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
       double shift = 0.0;
       for (const balance::Vec2& s : shift_m) shift = std::max(shift, s.norm());
       fmt::print(
-          "  correction (online, look-ahead {:.3f} s = {} frames): pelvis shift up to {:.1f} cm; feet down moved by at "
-          "most {:.2e} m; {:.0f} us per frame (max {:.0f} us)\n",
-          opt.lookahead_s, result.operator_band, 100.0 * shift, applied.max_foot_displacement_m, online_cost_us[0],
+          "  correction (online, look-ahead {:.3f} s = {} frames, window smoothing {:g} Hz): pelvis shift up to {:.1f} "
+          "cm; feet down moved by at most {:.2e} m; {:.0f} us per frame (max {:.0f} us)\n",
+          opt.lookahead_s, result.operator_band, opt.window_cutoff_hz, 100.0 * shift, applied.max_foot_displacement_m, online_cost_us[0],
           online_cost_us[1]);
     } else if (shift_m.empty()) {
       fmt::print("  correction: waist rotation up to {:.3f} rad, feet moved by at most {:.2e} m, {} iterations\n",

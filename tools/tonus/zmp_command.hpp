@@ -35,6 +35,8 @@ struct ZmpCommandOptions {
   double lookahead_s = 0.25;  // --online: how far ahead it sees, s (at most 0.25)
   // --online: the planner's violation weight (0: the plain preview).
   double plan_weight = balance::OnlineOptions{}.constraint_weight;
+  // --online: the window's smoothers' cut-off, Hz (--cutoff is the analysis's).
+  double window_cutoff_hz = balance::OnlineOptions{}.window_cutoff_hz;
   double margin_m = -1.0;  // negative: the correction's own (rotation 1 cm, waist 2 cm, online 1.5 cm)
   double max_correction_rad = 1.0;
   int max_iterations = 100;

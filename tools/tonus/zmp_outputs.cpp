@@ -146,6 +146,7 @@ bool write_zmp_json(const std::string& path, const ZmpReport& r, std::string& er
   if (r.online) {
     out += fmt::format("  \"online_us_per_frame\": {{\"mean\": {:.1f}, \"max\": {:.1f}}},\n", r.online_mean_us,
                        r.online_max_us);
+    out += fmt::format("  \"online_window_cutoff_hz\": {},\n", r.online_window_cutoff_hz);
   }
   out += family_json(r.family_before, r.family_after);
   out += "}\n";

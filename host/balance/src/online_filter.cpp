@@ -78,6 +78,8 @@ OnlineBalance::Created OnlineBalance::create(const OnlineOptions& o) {
   } else if (!positive(o.margin_m) || !positive(o.max_shift_m) || !positive(o.jerk_weight) ||
              !positive(o.com_height_m)) {
     c.error = "margin, shift cap, jerk weight and centre-of-mass height must be finite and positive";
+  } else if (!positive(o.window_cutoff_hz)) {
+    c.error = "the window's cut-off must be finite and positive";
   } else if (!(std::isfinite(o.constraint_weight) && o.constraint_weight >= 0.0)) {
     c.error = "the constraint weight must be finite and not negative";
   } else if (!(o.max_fine_shift_m >= 0.0 && o.max_fine_shift_m <= o.max_shift_m)) {
@@ -91,6 +93,7 @@ OnlineBalance::Created OnlineBalance::create(const OnlineOptions& o) {
   }
   derivatives::Params p = o.analysis.derivatives;
   p.method = derivatives::Method::kalman;  // the fixed-lag form of both Kalman methods
+  p.cutoff_hz = o.window_cutoff_hz;
   auto smoother = derivatives::FixedLag3::create(o.dt_s, p, lag);
   if (!smoother) {
     c.error = "smoothing: " + std::string(derivatives::to_string(smoother.status.error));
