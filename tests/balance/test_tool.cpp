@@ -125,8 +125,9 @@ TEST_CASE("tonus zmp --online: the streaming filter, its look-ahead and cost in 
   const Run r = run(clip + " --online --lookahead 0.2 -o " + temp("online.bvh") + " --json " + temp("online.json"));
   INFO(r.out);
   CHECK(r.code == 1);  // not yet balanced under every estimator (docs/balance.md)
-  CHECK(r.out.find("correction (online, look-ahead 0.200 s = 24 frames, window smoothing 10 Hz): pelvis shift up to ") !=
-        std::string::npos);
+  CHECK(
+      r.out.find("correction (online, look-ahead 0.200 s = 24 frames, window smoothing 10 Hz): pelvis shift up to ") !=
+      std::string::npos);
   CHECK(r.out.find("under each estimator") != std::string::npos);
   const std::string json = read_file(temp("online.json"));
   CHECK(json.find("\"online\": true") != std::string::npos);

@@ -304,8 +304,8 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
       fmt::print(
           "  correction (online, look-ahead {:.3f} s = {} frames, window smoothing {:g} Hz): pelvis shift up to {:.1f} "
           "cm; feet down moved by at most {:.2e} m; {:.0f} us per frame (max {:.0f} us)\n",
-          opt.lookahead_s, result.operator_band, opt.window_cutoff_hz, 100.0 * shift, applied.max_foot_displacement_m, online_cost_us[0],
-          online_cost_us[1]);
+          opt.lookahead_s, result.operator_band, opt.window_cutoff_hz, 100.0 * shift, applied.max_foot_displacement_m,
+          online_cost_us[0], online_cost_us[1]);
     } else if (shift_m.empty()) {
       fmt::print("  correction: waist rotation up to {:.3f} rad, feet moved by at most {:.2e} m, {} iterations\n",
                  report.max_correction_rad, applied.max_foot_displacement_m, result.iterations);

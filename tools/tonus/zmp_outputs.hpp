@@ -28,7 +28,7 @@ struct ZmpReport {
   bool online = false;          // the streaming filter made the correction
   double online_mean_us = 0.0;  // its cost per frame
   double online_max_us = 0.0;
-  double online_window_cutoff_hz = 0.0;  // its smoothing's cut-off
+  double online_window_cutoff_hz = 0.0;            // its smoothing's cut-off
   balance::Vec2 forward = balance::Vec2::UnitX();  // the plots' forward axis in the ground plane
 };
 
