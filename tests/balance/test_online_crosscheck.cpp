@@ -91,26 +91,29 @@ Crosschecked crosscheck(const std::string& name, const std::string& path, double
 // does not meet yet (docs/balance.md, "The online filter").
 TEST_CASE("online balance filter, crosschecked: Bandai walk, fewer frames outside, within 1.6 cm RMS of offline" *
           tonus::test::heavy_under_sanitizers()) {
-  // 140 -> 72 of 195; 1.37 cm RMS, 4.3 max (2026-12-05, the window
-  // smoothed at 10 Hz; 82 and 1.40 / 4.3 at 6 Hz; the plain preview at 6 Hz:
-  // 81 and 2.07 / 6.5).
+  // 140 -> 68 of 195; 1.32 cm RMS, 4.3 max (2026-12-05, the window
+  // smoothed at 10 Hz and the knee's side kept; 72 and 1.37 / 4.3 before
+  // that, 82 and 1.40 / 4.3 at 6 Hz; the plain preview at 6 Hz: 81 and
+  // 2.07 / 6.5).
   const Crosschecked c =
       crosscheck("Bandai walk", test::shared_clip("dataset-1_walk_normal_001.bvh"), indep::kCentimetre_m, 0);
   CHECK(c.independent_after < c.independent_before);
-  CHECK(c.independent_after <= 77);
+  CHECK(c.independent_after <= 73);
   CHECK(c.online_to_offline.rms_m < 0.016);
   CHECK(c.online_to_offline.max_m < 0.046);
 }
 
-TEST_CASE("online balance filter, crosschecked: Bandai kicks, fewer frames outside, within 2.7 cm RMS of offline" *
+TEST_CASE("online balance filter, crosschecked: Bandai kicks, fewer frames outside, within 3 cm RMS of offline" *
           tonus::test::heavy_under_sanitizers()) {
-  // 131 -> 91 of 358; 2.47 cm RMS, 7.0 max (the window at 10 Hz; at 6 Hz
-  // 91 and 2.47 / 6.4; the plain preview: 108 and 2.41 / 6.5).
+  // 131 -> 91 of 358; 2.85 cm RMS, 6.8 max (the window at 10 Hz, the
+  // knee's side kept: the offline edit grew, 3.2 -> 3.4 cm RMS; 2.47 / 7.0
+  // before it; at 6 Hz 91 and 2.47 / 6.4; the plain preview: 108 and
+  // 2.41 / 6.5).
   const Crosschecked c =
       crosscheck("Bandai kicks", test::shared_clip("dataset-1_kick_normal_001.bvh"), indep::kCentimetre_m, 0);
   CHECK(c.independent_after < c.independent_before);
   CHECK(c.independent_after <= 95);
-  CHECK(c.online_to_offline.rms_m < 0.027);
+  CHECK(c.online_to_offline.rms_m < 0.030);
   CHECK(c.online_to_offline.max_m < 0.072);
 }
 
@@ -120,7 +123,8 @@ TEST_CASE("online balance filter, crosschecked: CMU walk, fewer frames outside, 
   // clip's T-pose was streamed and its flat feet on a rising floor read as a
   // heel or a forefoot alone). 1.67 cm RMS, 2.7 max: the online edit is small
   // (0.54 cm RMS) where the offline one is 1.7. The plain preview (12-04): 96
-  // and 2.43 / 5.4. With the window smoothed at 10 Hz (12-05): 34, 1.66 / 2.8.
+  // and 2.43 / 5.4. With the window smoothed at 10 Hz (12-05): 34, 1.66 / 2.8;
+  // and the knee's side kept: 34, 1.44 / 3.3.
   const Crosschecked c = crosscheck("CMU walk", test::bundled_clip("cmu_02_walk.bvh"), indep::kCmuUnit_m, 1);
   CHECK(c.independent_after < c.independent_before);
   CHECK(c.independent_after <= 38);
@@ -130,16 +134,16 @@ TEST_CASE("online balance filter, crosschecked: CMU walk, fewer frames outside, 
 
 TEST_CASE("online balance filter, crosschecked: Bandai punches, fewer frames outside, within 3.1 cm RMS of offline" *
           tonus::test::heavy_under_sanitizers()) {
-  // 99 -> 60 of 224; 2.84 cm RMS, 7.0 max with the window smoothed at 10 Hz
-  // (12-05; 54 and 2.91 / 6.5 at 6 Hz, where the family's worst member has
-  // 84 against 77: the one clip the higher cut-off costs under this
-  // estimator). The plain preview put more frames outside under this
+  // 99 -> 58 of 224; 1.77 cm RMS, 4.5 max with the window smoothed at 10 Hz
+  // and the knee's side kept (12-05; 60 and 2.84 / 7.0 before that; 54 and
+  // 2.91 / 6.5 at 6 Hz, where the family's worst member has 84 against 77:
+  // the one clip the higher cut-off costs under this estimator). The plain preview put more frames outside under this
   // estimator than it brought in (104; 3.09 / 5.9), the boxer's bounce being
   // where the estimators part.
   const Crosschecked c =
       crosscheck("Bandai punches", test::shared_clip("dataset-1_punch_normal_001.bvh"), indep::kCentimetre_m, 0);
   CHECK(c.independent_after < c.independent_before);
-  CHECK(c.independent_after <= 63);
+  CHECK(c.independent_after <= 62);
   CHECK(c.online_to_offline.rms_m < 0.031);
   CHECK(c.online_to_offline.max_m < 0.074);
 }
@@ -150,12 +154,14 @@ TEST_CASE("online balance filter, crosschecked: Bandai run, fewer frames outside
   // models the support ratio: at the landings the offset's acceleration moves
   // the ZMP less than the cart-table says; 18 and 2.14 / 3.9 before): flight
   // phases leave few frames to correct (the plain preview: 21 and 3.73 / 6.8).
-  // The window at 10 Hz: 14, 2.61 / 4.2.
+  // The window at 10 Hz: 14, 2.61 / 4.2; with the knee's side kept, 15 and
+  // 2.88 / 7.3 (the offline result's landings moved: its edit 2.3 -> 2.1 cm
+  // RMS, the largest where the two part).
   const Crosschecked c =
       crosscheck("Bandai run", test::shared_clip("dataset-2_run_normal_010.bvh"), indep::kCentimetre_m, 0);
   CHECK(c.independent_after <= 16);
   CHECK(c.online_to_offline.rms_m < 0.030);
-  CHECK(c.online_to_offline.max_m < 0.050);
+  CHECK(c.online_to_offline.max_m < 0.076);
 }
 
 TEST_CASE("online balance filter, crosschecked: Bandai waving, balanced throughout, left as it was" *

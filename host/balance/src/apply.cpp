@@ -99,7 +99,6 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
       const double share = turn.follow[left ? 0 : 1];
       const auto carried = [&](const Vec3d& p) { return Vec3d(p + share * (pivot + r * (p - pivot) + drop - p)); };
       const Vec3d ankle2 = carried(ankle);
-      const Vec3d knee_pole = carried(knee);
       const Quatd foot_turn = to_int.conjugate() * turn.foot_turn(left ? 0 : 1) * to_int;
       const double l1 = (knee - hip).norm(), l2 = (ankle - knee).norm();
       const Vec3d d = ankle2 - hip2;
@@ -109,7 +108,10 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
       dist = std::min(dist, l1 + l2);
       const double a = (l1 * l1 - l2 * l2 + dist * dist) / (2.0 * dist);
       const double h = std::sqrt(std::max(l1 * l1 - a * a, 0.0));
-      Vec3d v = (knee_pole - hip2) - (knee_pole - hip2).dot(u) * u;
+      // The side the filter bent this knee to (its frame), in the file's.
+      const auto internal = [&](const Vec3d& p) { return Vec3d(to_int * (p * g.metres_per_unit)); };
+      Vec3d v = to_int.conjugate() * turn.knee_side(human.frames[f], left ? 0 : 1, internal(hip2), internal(ankle2));
+      v -= v.dot(u) * u;
       if (v.norm() < 1e-12) v = u.unitOrthogonal();
       v.normalize();
       const Vec3d knee2 = hip2 + a * u + h * v;

@@ -52,6 +52,32 @@ Vec3 WaistTurn::ankle_target(const Vec3& ankle, std::size_t leg) const {
 
 Quat WaistTurn::foot_turn(std::size_t leg) const { return Quat::Identity().slerp(follow[leg], rotation); }
 
+Vec3 WaistTurn::knee_side(const MotionFrame& in, std::size_t li, const Vec3& hip2, const Vec3& ankle2) const {
+  // The toes' pull once the hip has moved kPullFrom_m or more (less in
+  // proportion): a captured bend this small or smaller counts for little
+  // beside it (a knee is rarely straighter than this in a stance).
+  constexpr double kToesPull_m = 0.01, kPullFrom_m = 0.01;
+  const Leg& leg = kLegs[li];
+  const Vec3 hip = at(in, leg.thigh), knee = at(in, leg.shank), ankle = at(in, leg.ankle);
+  const Vec3 line = ankle2 - hip2;
+  const Vec3 u = line.normalized();
+  const auto square = [&](const Vec3& v) { return Vec3(v - v.dot(u) * u); };
+  const Vec3 line0 = ankle - hip;
+  Vec3 bend = knee - hip;
+  if (line0.squaredNorm() > 1e-18) bend -= bend.dot(line0) / line0.squaredNorm() * line0;
+  Vec3 toes = in.p[index(leg.toe_tip)] - ankle;
+  toes.z() = 0.0;
+  const double pull = kToesPull_m * std::min(1.0, (hip2 - hip).norm() / kPullFrom_m);
+  if (toes.norm() > 1e-9) bend += pull * toes.normalized();
+  // Carried as the foot is (a following foot's leg turns with the pelvis),
+  // then by the least turn from the captured line to the new one.
+  const Quat carry = foot_turn(li);
+  Vec3 v = square(sim::quat_from_two_vectors(carry * line0, line) * (carry * bend));
+  if (v.norm() < 1e-9) v = square(knee - hip);
+  if (v.norm() < 1e-9) v = u.unitOrthogonal();
+  return v.normalized();
+}
+
 WaistTurn waist_turn(const MotionFrame& in, const Vec3& delta, const Vec2& shift_m,
                      const std::array<double, 2>& follow) {
   WaistTurn w;
@@ -123,7 +149,6 @@ MotionFrame correct_waist(const MotionFrame& in, const Vec3& delta, const Vec2& 
       }
       for (const Landmark l : {leg.toe_tip, leg.heel}) out.p[index(l)] = ankle2 + foot_turn * (in.p[index(l)] - ankle);
     }
-    const Vec3 knee_pole = knee + w.follow[li] * (move(knee) - knee);
     const double l1 = (knee - hip).norm(), l2 = (ankle - knee).norm();
     const Vec3 d = ankle2 - hip2;
     const double dist = std::min(d.norm(), l1 + l2);
@@ -131,9 +156,7 @@ MotionFrame correct_waist(const MotionFrame& in, const Vec3& delta, const Vec2& 
     const Vec3 u = d.normalized();
     const double a = (l1 * l1 - l2 * l2 + dist * dist) / (2.0 * dist);
     const double h = std::sqrt(std::max(l1 * l1 - a * a, 0.0));
-    Vec3 v = (knee_pole - hip2) - (knee_pole - hip2).dot(u) * u;  // towards the captured (or carried) knee
-    if (v.norm() < 1e-9) v = u.unitOrthogonal();
-    v.normalize();
+    const Vec3 v = w.knee_side(in, li, hip2, ankle2);
     const Vec3 knee2 = hip2 + a * u + h * v;
     out.p[sim::index(leg.shank)] = knee2;
     out.rotation[sim::index(leg.thigh)] =

@@ -75,6 +75,15 @@ struct WaistTurn {
   // Where that leg's ankle goes, and its foot's turn.
   [[nodiscard]] Vec3 ankle_target(const Vec3& ankle, std::size_t leg) const;
   [[nodiscard]] Quat foot_turn(std::size_t leg) const;
+  // The unit direction, square to the re-solved leg's line from its moved hip
+  // joint `hip` to its ankle `ankle`, that its knee bends toward: the side the
+  // captured knee bends to from the captured line (carried with the foot's
+  // share of the turn), pulled toward the toes by up to a few millimetres as
+  // the hip moves (none with no correction, which then changes nothing) so a
+  // straight captured leg bends forward. Measured from the moved hip instead,
+  // the captured knee of a nearly straight leg lies behind the new line once
+  // the hip has moved further than the knee's bend, and the knee flips.
+  [[nodiscard]] Vec3 knee_side(const MotionFrame& frame, std::size_t leg, const Vec3& hip, const Vec3& ankle) const;
 
   double drop_m = 0.0;
   bool reachable = true;
