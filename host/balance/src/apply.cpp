@@ -108,12 +108,11 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
       dist = std::min(dist, l1 + l2);
       const double a = (l1 * l1 - l2 * l2 + dist * dist) / (2.0 * dist);
       const double h = std::sqrt(std::max(l1 * l1 - a * a, 0.0));
-      // The side the filter bent this knee to (its frame), in the file's.
+      // The side the filter bent this knee to, a unit vector square to the
+      // same line in its frame (the file's is a turn and a scale of it).
       const auto internal = [&](const Vec3d& p) { return Vec3d(to_int * (p * g.metres_per_unit)); };
-      Vec3d v = to_int.conjugate() * turn.knee_side(human.frames[f], left ? 0 : 1, internal(hip2), internal(ankle2));
-      v -= v.dot(u) * u;
-      if (v.norm() < 1e-12) v = u.unitOrthogonal();
-      v.normalize();
+      const Vec3d v =
+          to_int.conjugate() * turn.knee_side(human.frames[f], left ? 0 : 1, internal(hip2), internal(ankle2));
       const Vec3d knee2 = hip2 + a * u + h * v;
       desired[tu] = static_cast<int>(wanted.size());
       wanted.push_back(sim::quat_from_two_vectors(knee - hip, knee2 - hip2) * poses[tu].rotation);
