@@ -237,7 +237,7 @@ void OnlineBalance::emit(std::size_t frames_back, OnlineFrame& out) {
       out.shift_capped = true;
     }
   }
-  // The fine layer: the frame's centre of mass onto the smoothed one.
+  // The fine layer (fine_shift, below): the capture's jitter out of what the ZMP sees.
   Vec2 fine = Vec2::Zero();
   if (options_.max_fine_shift_m > 0.0) {
     SegmentFrame smoothed = placed_[k % (lag_ + 1)];
@@ -247,10 +247,7 @@ void OnlineBalance::emit(std::size_t frames_back, OnlineFrame& out) {
       valid = valid && e.valid;
       if (e.valid) smoothed[i].com = e.pos;
     }
-    if (valid) {
-      const Vec3 d = centre_of_mass(mass_, smoothed) - centre_of_mass(mass_, placed_[k % (lag_ + 1)]);
-      fine = (d.head<2>() / share).cwiseMax(-options_.max_fine_shift_m).cwiseMin(options_.max_fine_shift_m);
-    }
+    if (valid) fine = fine_shift(f, placed_[k % (lag_ + 1)], smoothed, shift);
   }
   shift += fine;
   bool reachable = true;
@@ -298,6 +295,38 @@ void OnlineBalance::emit(std::size_t frames_back, OnlineFrame& out) {
   out.outside_before_m = outside_[w];
   out.reachable = reachable;
   ++emitted_;
+}
+
+// The fine layer's shift: the ZMP's acceleration term is sum_i m_i (z_i -
+// ground) a_i, so the capture's jitter weighs by each segment's height; a
+// pelvis shift moves each segment by its own share (the trunk, arms and head
+// fully, the legs in part, the feet not). The shift that moves that
+// height-weighted sum by the smoothers' estimate minus the capture is the
+// difference over the height-weighted share, per axis, within the cap.
+Vec2 OnlineBalance::fine_shift(const MotionFrame& f, const SegmentFrame& captured, const SegmentFrame& smoothed,
+                               const Vec2& shift) const {
+  constexpr double kProbe_m = 1e-3;
+  const double ground = contacts_.track().ground_z_m;
+  const SegmentFrame at = place_segments(mass_, correct_waist(f, Vec3::Zero(), shift).p);
+  std::array<SegmentFrame, 2> moved;
+  for (Eigen::Index a = 0; a < 2; ++a) {
+    Vec2 probe = shift;
+    probe[a] += kProbe_m;
+    moved[static_cast<std::size_t>(a)] = place_segments(mass_, correct_waist(f, Vec3::Zero(), probe).p);
+  }
+  Vec2 wanted = Vec2::Zero(), moves = Vec2::Zero();
+  for (std::size_t i = 0; i < kSegmentParts; ++i) {
+    const double w = mass_.parts[i].mass_kg * std::max(captured[i].com.z() - ground, 0.0);
+    wanted += w * (smoothed[i].com - captured[i].com).head<2>();
+    for (Eigen::Index a = 0; a < 2; ++a)
+      moves[a] += w * (moved[static_cast<std::size_t>(a)][i].com[a] - at[i].com[a]) / kProbe_m;
+  }
+  Vec2 fine = Vec2::Zero();
+  for (Eigen::Index a = 0; a < 2; ++a) {
+    if (moves[a] > 1e-9)
+      fine[a] = std::clamp(wanted[a] / moves[a], -options_.max_fine_shift_m, options_.max_fine_shift_m);
+  }
+  return fine;
 }
 
 // The planner's half-planes for the frames after window position w: each

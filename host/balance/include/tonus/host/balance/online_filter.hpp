@@ -61,9 +61,11 @@ struct OnlineOptions {
   double margin_m = 0.015;    // the ZMP is brought this far inside its polygon
   double max_shift_m = 0.08;  // the pelvis's horizontal shift, either axis
   // A fine layer of pelvis shift, at most this much per axis, that takes
-  // capture jitter out of the centre of mass: it moves the frame's centre of
-  // mass onto the smoothers' estimate at full look-ahead, the path the ZMP
-  // errors were computed on (0: off). The robust filter's fine layer, online.
+  // capture jitter out of what the ZMP sees: it moves the segments' centres of
+  // mass, weighted by mass and height above the ground (the ZMP's
+  // acceleration term), onto the smoothers' estimate at full look-ahead, the
+  // path the ZMP errors were computed on (0: off). The robust filter's fine
+  // layer, online.
   double max_fine_shift_m = 0.005;
   // Where the cap or a straight leg holds the shift back, the preview's cart
   // goes on from the shift applied, not the one asked for (false: it winds
@@ -126,6 +128,8 @@ class OnlineBalance {
   void plan_rows(std::size_t w, std::size_t held);
   void window_errors();
   void emit(std::size_t frames_back, OnlineFrame& out);
+  [[nodiscard]] Vec2 fine_shift(const MotionFrame& f, const SegmentFrame& captured, const SegmentFrame& smoothed,
+                                const Vec2& shift) const;
 
   OnlineOptions options_;
   std::size_t lag_;
