@@ -266,29 +266,67 @@ ConvexPolygon support_polygon(const ContactTrack& track, const MotionFrame& fram
   return support_polygon(track, frame, track.frames[t]);
 }
 
-ConvexPolygon support_polygon(const ContactTrack& track, const MotionFrame& frame,
-                              const std::array<FootContact, 2>& contacts) {
-  std::vector<Vec2> pts;
+namespace {
+
+// The supporting points of both feet (the parts of each sole under its
+// touching points), each handed to `add` in the ground plane.
+template <class Add>
+void supporting_points(const ContactTrack& track, const MotionFrame& frame, const std::array<FootContact, 2>& contacts,
+                       Add add) {
   for (const Foot foot : {Foot::left, Foot::right}) {
     const auto fi = static_cast<std::size_t>(foot);
     const FootContact c = contacts[fi];
     if (!c.any()) continue;
-    const SoleWorld w = place(track.soles[fi], frame, foot);
+    const Sole& sole = track.soles[fi];
+    const FootLandmarks f = foot_landmarks(foot);
+    const Quat foot_rot = foot_rotation(frame, foot);
+    const Quat toes_rot = frame.rotation[sim::index(foot == Foot::left ? sim::Bone::LeftToes : sim::Bone::RightToes)];
+    const Vec3 ankle = frame.p[index(f.ankle)], ball = frame.p[index(f.toe_joint)];
     if (c.ball) {
-      for (const Vec3& p : w.ball) pts.push_back(horizontal(p));
-      for (const Vec3& p : w.toes) pts.push_back(horizontal(p));
+      for (const Vec3& p : sole.ball) add(horizontal(ankle + foot_rot * p));
+      for (const Vec3& p : sole.toes) add(horizontal(ball + toes_rot * p));
     }
     if (c.heel) {
-      for (const Vec3& p : w.rear) pts.push_back(horizontal(p));
+      for (const Vec3& p : sole.rear) add(horizontal(ankle + foot_rot * p));
       if (!c.ball) {  // heel strike: the rear of the sole
-        for (std::size_t k = 0; k < w.rear.size() && k < w.ball.size(); ++k) {
-          const double share = kRearFootShare / (kHeelBehindAnkle + kBallAheadOfAnkle);
-          pts.push_back(horizontal(w.rear[k] + share * (w.ball[k] - w.rear[k])));
+        const double share = kRearFootShare / (kHeelBehindAnkle + kBallAheadOfAnkle);
+        for (std::size_t k = 0; k < sole.rear.size() && k < sole.ball.size(); ++k) {
+          const Vec3 rear = ankle + foot_rot * sole.rear[k], front = ankle + foot_rot * sole.ball[k];
+          add(horizontal(rear + share * (front - rear)));
         }
       }
     }
   }
-  return convex_hull(pts);
+}
+
+}  // namespace
+
+void support_polygon(const ContactTrack& track, const MotionFrame& frame, const std::array<FootContact, 2>& contacts,
+                     ConvexPolygon& out) {
+  std::array<Vec2, kHullInlinePoints> inline_points;
+  std::size_t n = 0;
+  bool overflow = false;
+  supporting_points(track, frame, contacts, [&](const Vec2& p) {
+    if (n < inline_points.size())
+      inline_points[n++] = p;
+    else
+      overflow = true;
+  });
+  if (!overflow) {
+    convex_hull(std::span<const Vec2>(inline_points.data(), n), out);
+    return;
+  }
+  // Soles with more corners than fit (not the measured ones): on the heap.
+  std::vector<Vec2> pts;
+  supporting_points(track, frame, contacts, [&](const Vec2& p) { pts.push_back(p); });
+  convex_hull(pts, out);
+}
+
+ConvexPolygon support_polygon(const ContactTrack& track, const MotionFrame& frame,
+                              const std::array<FootContact, 2>& contacts) {
+  ConvexPolygon out;
+  support_polygon(track, frame, contacts, out);
+  return out;
 }
 
 std::vector<Vec2> sole_outline(const ContactTrack& track, const MotionFrame& frame, Foot foot) {
@@ -343,6 +381,7 @@ std::array<FootContact, 2> CausalContacts::push(const MotionFrame& frame) {
     if (score < flattest_[fi]) {
       flattest_[fi] = score;
       track_.soles[fi] = measure_sole(frame, foot, track_.ground_z_m, options_);
+      ++soles_measured_;
     }
     last_ankle_[fi] = ankle;
     last_ball_[fi] = ball;

@@ -3,7 +3,8 @@
 #include "tonus/host/balance/mass_model.hpp"
 
 #include <algorithm>
-#include <vector>
+#include <array>
+#include <span>
 
 namespace tonus::balance {
 namespace {
@@ -22,7 +23,7 @@ Vec3 at(const LandmarkFrame& f, Landmark l) { return f[index(l)]; }
 Vec3 at(const LandmarkFrame& f, Bone b) { return f[sim::index(b)]; }
 
 // A point at arc length s along a polyline.
-Vec3 along(const std::vector<Vec3>& line, double s) {
+Vec3 along(std::span<const Vec3> line, double s) {
   for (std::size_t i = 0; i + 1 < line.size(); ++i) {
     const double len = (line[i + 1] - line[i]).norm();
     if (s <= len || i + 2 == line.size())
@@ -61,14 +62,15 @@ SegmentFrame place_segments(const MassModel& model, const LandmarkFrame& f) {
   out[0] = between(at(f, Landmark::HeadTop), at(f, Bone::Neck), p(Segment::head).com_fraction);
 
   // Trunk: mid-hip up the spine joints to the neck base, split at de Leva's length proportions.
-  std::vector<Vec3> spine{at(f, Landmark::MidHip), at(f, Bone::Spine), at(f, Bone::Chest), at(f, Bone::Neck)};
+  const std::array<Vec3, 4> spine{at(f, Landmark::MidHip), at(f, Bone::Spine), at(f, Bone::Chest), at(f, Bone::Neck)};
   double total = 0.0;
   for (std::size_t i = 0; i + 1 < spine.size(); ++i) total += (spine[i + 1] - spine[i]).norm();
   const double lower = p(Segment::lower_trunk).length_m, middle = p(Segment::middle_trunk).length_m,
                upper = p(Segment::upper_trunk).length_m;
   const double scale = total / (lower + middle + upper);
-  const Vec3 midh = spine.front(), omph = along(spine, lower * scale), xyph = along(spine, (lower + middle) * scale),
-             cerv = spine.back();
+  const Vec3& midh = spine.front();
+  const Vec3& cerv = spine.back();
+  const Vec3 omph = along(spine, lower * scale), xyph = along(spine, (lower + middle) * scale);
   out[1] = between(cerv, xyph, p(Segment::upper_trunk).com_fraction);
   out[2] = between(xyph, omph, p(Segment::middle_trunk).com_fraction);
   out[3] = between(omph, midh, p(Segment::lower_trunk).com_fraction);

@@ -125,6 +125,7 @@ OnlineBalance::OnlineBalance(const OnlineOptions& options, std::size_t lag, cons
       ratio_(lag + 1, 1.0),
       outside_(lag + 1, 0.0),
       defined_(lag + 1, false) {
+  for (ConvexPolygon& p : polygons_) p.vertices.reserve(kHullInlinePoints);
   errors_[0].assign(lag + 1, 0.0);
   errors_[1].assign(lag + 1, 0.0);
   if (options.constraint_weight > 0.0) {
@@ -151,7 +152,10 @@ bool OnlineBalance::push(const MotionFrame& in, OnlineFrame& out) {
   const MotionFrame& f = frames_[slot];
   frame_contacts_[slot] = contacts_.push(f);
   const auto& c = frame_contacts_[slot];
-  polygons_[slot] = c[0].any() || c[1].any() ? support_polygon(contacts_.track(), f, c) : ConvexPolygon{};
+  if (c[0].any() || c[1].any())
+    support_polygon(contacts_.track(), f, c, polygons_[slot]);
+  else
+    polygons_[slot].vertices.clear();
   placed_[slot] = place_segments(mass_, f.p);
   const SegmentFrame& seg = placed_[slot];
   for (std::size_t i = 0; i < kSegmentParts; ++i) segments_[i].push(seg[i].com);

@@ -3,8 +3,10 @@
 #include "tonus/host/balance/polygon.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace tonus::balance {
 namespace {
@@ -49,32 +51,56 @@ Vec2 nearest_on_boundary(const ConvexPolygon& poly, const Vec2& p) {
 
 }  // namespace
 
-ConvexPolygon convex_hull(std::span<const Vec2> points) {
-  std::vector<Vec2> pts;
-  pts.reserve(points.size());
-  for (const Vec2& p : points) {
-    if (std::isfinite(p.x()) && std::isfinite(p.y())) pts.push_back(p);
-  }
+namespace {
+
+// The hull of `pts` (finite, in any order; sorted and deduplicated here) into
+// `out`, with `h` (twice as long as pts) as the chain's workspace.
+void hull_of(std::span<Vec2> pts, std::span<Vec2> h, ConvexPolygon& out) {
   std::sort(pts.begin(), pts.end(),
             [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
-  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
-  ConvexPolygon hull;
-  if (pts.size() < 3) {
-    hull.vertices = pts;
-    return hull;
+  const auto n = static_cast<std::size_t>(std::unique(pts.begin(), pts.end()) - pts.begin());
+  if (n < 3) {
+    out.vertices.assign(pts.begin(), pts.begin() + static_cast<std::ptrdiff_t>(n));
+    return;
   }
-  std::vector<Vec2> h(2 * pts.size());
   std::size_t k = 0;
-  for (const Vec2& p : pts) {  // lower hull
-    while (k >= 2 && cross(h[k - 2], h[k - 1], p) <= 0.0) --k;
-    h[k++] = p;
+  for (std::size_t i = 0; i < n; ++i) {  // lower hull
+    while (k >= 2 && cross(h[k - 2], h[k - 1], pts[i]) <= 0.0) --k;
+    h[k++] = pts[i];
   }
-  for (std::size_t i = pts.size() - 1, lower = k + 1; i-- > 0;) {  // upper hull
+  for (std::size_t i = n - 1, lower = k + 1; i-- > 0;) {  // upper hull
     while (k >= lower && cross(h[k - 2], h[k - 1], pts[i]) <= 0.0) --k;
     h[k++] = pts[i];
   }
-  h.resize(k - 1);
-  hull.vertices = std::move(h);
+  out.vertices.assign(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(k - 1));
+}
+
+}  // namespace
+
+void convex_hull(std::span<const Vec2> points, ConvexPolygon& out) {
+  const auto finite = [](const Vec2& p) { return std::isfinite(p.x()) && std::isfinite(p.y()); };
+  if (points.size() <= kHullInlinePoints) {
+    std::array<Vec2, kHullInlinePoints> pts;
+    std::array<Vec2, 2 * kHullInlinePoints> h;
+    std::size_t n = 0;
+    for (const Vec2& p : points) {
+      if (finite(p)) pts[n++] = p;
+    }
+    hull_of(std::span<Vec2>(pts.data(), n), std::span<Vec2>(h.data(), 2 * n), out);
+    return;
+  }
+  std::vector<Vec2> pts;
+  pts.reserve(points.size());
+  for (const Vec2& p : points) {
+    if (finite(p)) pts.push_back(p);
+  }
+  std::vector<Vec2> h(2 * pts.size());
+  hull_of(pts, h, out);
+}
+
+ConvexPolygon convex_hull(std::span<const Vec2> points) {
+  ConvexPolygon hull;
+  convex_hull(points, hull);
   return hull;
 }
 

@@ -65,6 +65,11 @@ ConvexPolygon support_polygon(const ContactTrack& track, const MotionFrame& fram
 // The same from the frame's contacts given directly.
 ConvexPolygon support_polygon(const ContactTrack& track, const MotionFrame& frame,
                               const std::array<FootContact, 2>& contacts);
+// The same into `out`, reusing its storage: allocates nothing when
+// out.vertices has the capacity (kHullInlinePoints) and the soles are the
+// measured ones (a few corners each).
+void support_polygon(const ContactTrack& track, const MotionFrame& frame, const std::array<FootContact, 2>& contacts,
+                     ConvexPolygon& out);
 
 // The sole of one foot measured on one frame where it stands flat on the
 // ground at ground_z (what detect_contacts does on the flattest frame).
@@ -93,6 +98,8 @@ class CausalContacts {
   // The ground and soles so far (its `frames` stay empty).
   [[nodiscard]] const ContactTrack& track() const { return track_; }
   [[nodiscard]] std::size_t pushed() const { return pushed_; }
+  // How many times a sole was measured (the only pushes that allocate).
+  [[nodiscard]] std::size_t soles_measured() const { return soles_measured_; }
 
  private:
   struct Point {
@@ -107,6 +114,7 @@ class CausalContacts {
   double dt_s_;
   std::size_t window_;
   std::size_t pushed_ = 0;
+  std::size_t soles_measured_ = 0;
   ContactTrack track_;
   std::vector<double> lows_;                    // ring: the lowest foot point per frame
   std::array<std::array<Point, 2>, 2> points_;  // [foot][heel, ball]

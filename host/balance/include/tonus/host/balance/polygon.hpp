@@ -2,6 +2,7 @@
 // polygon (their convex hull), with the queries the balance filter needs.
 #pragma once
 
+#include <cstddef>
 #include <span>
 #include <vector>
 
@@ -17,6 +18,13 @@ struct ConvexPolygon {
 
 // Andrew's monotone chain. Collinear points on the hull are dropped.
 ConvexPolygon convex_hull(std::span<const Vec2> points);
+
+// Up to this many points, the hull is taken in place (below).
+inline constexpr std::size_t kHullInlinePoints = 64;
+// The same into `out`, reusing its storage: it allocates nothing for at most
+// kHullInlinePoints points when out.vertices has the capacity for them (the
+// online filter's rings reserve it once).
+void convex_hull(std::span<const Vec2> points, ConvexPolygon& out);
 
 // Signed distance from p to the polygon's boundary: negative inside, positive
 // outside (for a point or segment polygon: the plain distance). Infinite for an empty polygon.
