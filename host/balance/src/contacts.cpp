@@ -102,15 +102,28 @@ struct SoleWorld {
   std::vector<Vec3> rear, ball, toes;
 };
 
-SoleWorld place(const Sole& s, const MotionFrame& fr, Foot foot) {
+// Where a foot's sole is at a frame: its rear and ball corners ride on the
+// foot (from the ankle), its toe corners on the toes (from the toe joint).
+struct SolePose {
+  Quat foot_rot, toes_rot;
+  Vec3 ankle, ball;
+  [[nodiscard]] Vec3 on_foot(const Vec3& p) const { return ankle + foot_rot * p; }
+  [[nodiscard]] Vec3 on_toes(const Vec3& p) const { return ball + toes_rot * p; }
+};
+
+SolePose sole_pose(const MotionFrame& fr, Foot foot) {
   const FootLandmarks f = foot_landmarks(foot);
-  const Quat foot_rot = foot_rotation(fr, foot);
-  const Quat toes_rot = fr.rotation[sim::index(foot == Foot::left ? sim::Bone::LeftToes : sim::Bone::RightToes)];
-  const Vec3 ankle = fr.p[index(f.ankle)], ball = fr.p[index(f.toe_joint)];
+  return {foot_rotation(fr, foot),
+          fr.rotation[sim::index(foot == Foot::left ? sim::Bone::LeftToes : sim::Bone::RightToes)],
+          fr.p[index(f.ankle)], fr.p[index(f.toe_joint)]};
+}
+
+SoleWorld place(const Sole& s, const MotionFrame& fr, Foot foot) {
+  const SolePose pose = sole_pose(fr, foot);
   SoleWorld w;
-  for (const Vec3& p : s.rear) w.rear.emplace_back(ankle + foot_rot * p);
-  for (const Vec3& p : s.ball) w.ball.emplace_back(ankle + foot_rot * p);
-  for (const Vec3& p : s.toes) w.toes.emplace_back(ball + toes_rot * p);
+  for (const Vec3& p : s.rear) w.rear.push_back(pose.on_foot(p));
+  for (const Vec3& p : s.ball) w.ball.push_back(pose.on_foot(p));
+  for (const Vec3& p : s.toes) w.toes.push_back(pose.on_toes(p));
   return w;
 }
 
@@ -278,20 +291,17 @@ void supporting_points(const ContactTrack& track, const MotionFrame& frame, cons
     const FootContact c = contacts[fi];
     if (!c.any()) continue;
     const Sole& sole = track.soles[fi];
-    const FootLandmarks f = foot_landmarks(foot);
-    const Quat foot_rot = foot_rotation(frame, foot);
-    const Quat toes_rot = frame.rotation[sim::index(foot == Foot::left ? sim::Bone::LeftToes : sim::Bone::RightToes)];
-    const Vec3 ankle = frame.p[index(f.ankle)], ball = frame.p[index(f.toe_joint)];
+    const SolePose pose = sole_pose(frame, foot);
     if (c.ball) {
-      for (const Vec3& p : sole.ball) add(horizontal(ankle + foot_rot * p));
-      for (const Vec3& p : sole.toes) add(horizontal(ball + toes_rot * p));
+      for (const Vec3& p : sole.ball) add(horizontal(pose.on_foot(p)));
+      for (const Vec3& p : sole.toes) add(horizontal(pose.on_toes(p)));
     }
     if (c.heel) {
-      for (const Vec3& p : sole.rear) add(horizontal(ankle + foot_rot * p));
+      for (const Vec3& p : sole.rear) add(horizontal(pose.on_foot(p)));
       if (!c.ball) {  // heel strike: the rear of the sole
         const double share = kRearFootShare / (kHeelBehindAnkle + kBallAheadOfAnkle);
         for (std::size_t k = 0; k < sole.rear.size() && k < sole.ball.size(); ++k) {
-          const Vec3 rear = ankle + foot_rot * sole.rear[k], front = ankle + foot_rot * sole.ball[k];
+          const Vec3 rear = pose.on_foot(sole.rear[k]), front = pose.on_foot(sole.ball[k]);
           add(horizontal(rear + share * (front - rear)));
         }
       }
