@@ -163,8 +163,29 @@ TEST_CASE("tonus zmp: bad input is refused with exit code 2 and a reason") {
   const std::string clip = std::string(TONUS_SOURCE_DIR) + "/tests/data/cmu_02_walk.bvh";
   CHECK(run(clip + " --unit furlong").code == 2);
   CHECK(run(clip + " --derivative magic").code == 2);
+  const Run trunk = run(clip + " --trunk bent");
+  CHECK(trunk.code == 2);
+  CHECK(trunk.out.find("--trunk: spine or straight") != std::string::npos);
   { std::ofstream(temp("map.txt")) << "LeftUpperLeg = nothing_like_it\n"; }
   const Run mapped = run(clip + " --mapping " + temp("map.txt"));
   CHECK(mapped.code == 2);
   CHECK(mapped.out.find("nothing_like_it") != std::string::npos);
+}
+
+TEST_CASE("tonus zmp --trunk straight: the trunk's mass on the hips-neck line, another estimate of the same clip") {
+  const std::string clip = std::string(TONUS_SOURCE_DIR) + "/tests/data/cmu_02_walk.bvh";
+  const auto outside_before = [&](const std::string& trunk) {
+    const std::string json = temp("trunk_" + trunk + ".json");
+    const Run r = run(clip + " --unit cmu --iterations 0 -q --trunk " + trunk + " --json " + json);
+    CHECK(r.code != 2);
+    std::smatch m;
+    const std::string text = read_file(json);
+    REQUIRE(std::regex_search(text, m, std::regex("\"frames_outside_before\": ([0-9]+)")));
+    return std::stoi(m[1].str());
+  };
+  const int spine = outside_before("spine"), straight = outside_before("straight");
+  MESSAGE("CMU walk, frames outside before correction: trunk along the spine " << spine << ", straight " << straight);
+  CHECK(spine > 0);
+  CHECK(straight > 0);
+  CHECK(straight != spine);
 }

@@ -62,6 +62,29 @@ TEST_CASE("mass model: de Leva's parts add up to the body mass, and place a plau
   CHECK((thigh.com - (hip + 0.4095 * (knee - hip))).norm() < 1e-12);
 }
 
+TEST_CASE("mass model: the trunk along the spine joints, or straight from the hips to the neck") {
+  const MassModel spine = make_mass_model(70.0, tonus::sim::Sex::male);
+  const MassModel straight = make_mass_model(70.0, tonus::sim::Sex::male, TrunkModel::straight);
+  CHECK(spine.trunk == TrunkModel::spine);
+  // Spine joints on the hips-neck line: the same placement either way.
+  const LandmarkFrame upright = standing();
+  const SegmentFrame a = place_segments(spine, upright), b = place_segments(straight, upright);
+  for (std::size_t i = 0; i < kSegmentParts; ++i) CHECK((a[i].com - b[i].com).norm() < 1e-12);
+  // A chest 6 cm forward of the line: the spine model's trunk follows it, the
+  // straight one keeps its parts on the line from the mid-hip point to the neck.
+  LandmarkFrame bent = upright;
+  bent[index(joint_of(tonus::sim::Bone::Chest))].x() += 0.06;
+  const SegmentFrame sb = place_segments(spine, bent), tb = place_segments(straight, bent);
+  for (std::size_t i = 1; i <= 3; ++i) {
+    CHECK(std::abs(tb[i].com.x()) < 1e-12);
+    CHECK(tb[i].com.z() == doctest::Approx(a[i].com.z()).epsilon(1e-9));
+  }
+  CHECK(sb[2].com.x() > 0.02);  // the middle trunk, around the chest joint
+  // Everything but the trunk is placed the same.
+  for (const std::size_t i : {std::size_t{0}, std::size_t{4}, std::size_t{10}, std::size_t{15}})
+    CHECK((sb[i].com - tb[i].com).norm() < 1e-12);
+}
+
 TEST_CASE("ZMP of a static pose is the ground projection of the centre of mass") {
   const MassModel m = make_mass_model(70.0, tonus::sim::Sex::female);
   const SegmentFrame s = place_segments(m, standing());

@@ -55,6 +55,9 @@ int run(int argc, char** argv) {
                       "Length unit of the file: m, cm, mm, inch, cmu or metres per unit (default: guessed)");
   zmp_cmd->add_option("--mass", zmp.body_mass_kg, "Body mass, kg")->check(CLI::Range(5.0, 500.0));
   zmp_cmd->add_option("--sex", zmp.sex, "de Leva table: male or female");
+  zmp_cmd->add_option("--trunk", zmp.trunk,
+                      "Where the trunk's mass lies: spine (along the spine joints, default) or straight (one rigid "
+                      "trunk from the hips to the neck)");
   zmp_cmd->add_option("--foot-length", zmp.foot_length_m, "Sole length, m (default: from the skeleton)")
       ->check(CLI::Range(0.05, 0.5));
   zmp_cmd->add_option("--ground-height", zmp.ground_height_m,

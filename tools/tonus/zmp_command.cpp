@@ -178,6 +178,8 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
   ao.body_mass_kg = opt.body_mass_kg;
   if (opt.sex != "male" && opt.sex != "female") return fail("--sex: male or female");
   ao.sex = opt.sex == "male" ? sim::Sex::male : sim::Sex::female;
+  if (opt.trunk != "spine" && opt.trunk != "straight") return fail("--trunk: spine or straight");
+  ao.trunk = opt.trunk == "spine" ? balance::TrunkModel::spine : balance::TrunkModel::straight;
   ao.angular_momentum = opt.full_zmp;
   if (!parse_method(opt.derivative, ao.derivatives.method)) {
     return fail("--derivative: kalman_spline, kalman, spline or finite_difference");

@@ -22,6 +22,7 @@ struct ZmpCommandOptions {
   std::string unit;     // m, cm, mm, inch, cmu, or metres per unit; empty: guess
   double body_mass_kg = 70.0;
   std::string sex = "male";
+  std::string trunk = "spine";
   std::optional<double> foot_length_m;
   std::optional<double> ground_height_m;
   double contact_height_m = 0.025;

@@ -12,7 +12,7 @@ namespace detail {
 
 void place_all_segments(Analysis& a, const HumanMotion& motion, const AnalysisOptions& opt,
                         const ContactTrack* contacts) {
-  a.mass = make_mass_model(opt.body_mass_kg, opt.sex);
+  a.mass = make_mass_model(opt.body_mass_kg, opt.sex, opt.trunk);
   a.contacts = contacts != nullptr ? *contacts : detect_contacts(motion, opt.contacts);
   const std::size_t n = motion.size();
   a.frames.assign(n, {});

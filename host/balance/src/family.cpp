@@ -50,7 +50,8 @@ std::vector<Analysis> analyse_family(const HumanMotion& motion, const std::vecto
     for (std::size_t j = i; j < members.size(); ++j) {
       if (done[j] || !same_derivatives(members[j].derivatives, members[i].derivatives)) continue;
       out[j] = diff;
-      if (members[j].body_mass_kg != members.front().body_mass_kg || members[j].sex != members.front().sex) {
+      if (members[j].body_mass_kg != members.front().body_mass_kg || members[j].sex != members.front().sex ||
+          members[j].trunk != members.front().trunk) {
         out[j] = analyse(motion, members[j], &contacts);  // another body: nothing to share
       } else {
         detail::evaluate_frames(out[j], motion, members[j], members[j].angular_momentum ? ang_rate : none);

@@ -44,9 +44,10 @@ SegmentState between(const Vec3& proximal, const Vec3& distal, double com_fracti
 
 }  // namespace
 
-MassModel make_mass_model(double body_mass_kg, sim::Sex sex) {
+MassModel make_mass_model(double body_mass_kg, sim::Sex sex, TrunkModel trunk) {
   MassModel m;
   m.sex = sex;
+  m.trunk = trunk;
   m.total_mass_kg = body_mass_kg;
   const double total = sim::total_mass_fraction(sex);  // 1 within de Leva's rounding
   for (std::size_t i = 0; i < kSegmentParts; ++i) {
@@ -61,8 +62,13 @@ SegmentFrame place_segments(const MassModel& model, const LandmarkFrame& f) {
   // Head: vertex (proximal) to the neck base.
   out[0] = between(at(f, Landmark::HeadTop), at(f, Bone::Neck), p(Segment::head).com_fraction);
 
-  // Trunk: mid-hip up the spine joints to the neck base, split at de Leva's length proportions.
-  const std::array<Vec3, 4> spine{at(f, Landmark::MidHip), at(f, Bone::Spine), at(f, Bone::Chest), at(f, Bone::Neck)};
+  // Trunk: mid-hip up the spine joints to the neck base (or straight to it),
+  // split at de Leva's length proportions.
+  const Vec3 mid_hip = at(f, Landmark::MidHip), neck = at(f, Bone::Neck);
+  const std::array<Vec3, 4> polyline{mid_hip, at(f, Bone::Spine), at(f, Bone::Chest), neck};
+  const std::array<Vec3, 2> line{mid_hip, neck};
+  const std::span<const Vec3> spine =
+      model.trunk == TrunkModel::straight ? std::span<const Vec3>(line) : std::span<const Vec3>(polyline);
   double total = 0.0;
   for (std::size_t i = 0; i + 1 < spine.size(); ++i) total += (spine[i + 1] - spine[i]).norm();
   const double lower = p(Segment::lower_trunk).length_m, middle = p(Segment::middle_trunk).length_m,

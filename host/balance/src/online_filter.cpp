@@ -112,7 +112,7 @@ OnlineBalance::OnlineBalance(const OnlineOptions& options, std::size_t lag, cons
                              PreviewModel preview)
     : options_(options),
       lag_(lag),
-      mass_(make_mass_model(options.analysis.body_mass_kg, options.analysis.sex)),
+      mass_(make_mass_model(options.analysis.body_mass_kg, options.analysis.sex, options.analysis.trunk)),
       contacts_(options.analysis.contacts, options.dt_s),
       segments_(kSegmentParts, smoother),
       preview_(std::move(preview)),

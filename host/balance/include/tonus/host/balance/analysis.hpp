@@ -18,7 +18,8 @@ namespace tonus::balance {
 struct AnalysisOptions {
   double body_mass_kg = 70.0;  // scales forces, not the ZMP (which depends on mass ratios only)
   sim::Sex sex = sim::Sex::male;
-  bool angular_momentum = false;  // the full form: add the segments' angular momentum rate
+  TrunkModel trunk = TrunkModel::spine;  // where the trunk's mass lies (mass_model.hpp)
+  bool angular_momentum = false;         // the full form: add the segments' angular momentum rate
   derivatives::Params derivatives;
   ContactOptions contacts;
   double gravity = 9.81;

@@ -23,13 +23,22 @@ struct SegmentPart {
   double mass_kg;
 };
 
+// Where the trunk's three parts lie. `spine`: along the polyline from the
+// mid-hip point up the spine joints to the neck base, so a bending spine
+// carries them. `straight`: on the straight line from the mid-hip point to the
+// neck base, where a model with one rigid trunk (de Leva's CERV-MIDH segment:
+// the independent estimator of the tests, the audit of issue 14) has them.
+// The two differ by centimetres of ZMP on lively clips (docs/balance.md).
+enum class TrunkModel { spine, straight };
+
 struct MassModel {
   std::array<SegmentPart, kSegmentParts> parts{};
   double total_mass_kg = 0.0;
   sim::Sex sex = sim::Sex::male;
+  TrunkModel trunk = TrunkModel::spine;
 };
 
-MassModel make_mass_model(double body_mass_kg, sim::Sex sex);
+MassModel make_mass_model(double body_mass_kg, sim::Sex sex, TrunkModel trunk = TrunkModel::spine);
 
 // Per frame: each part's centre of mass, and its longitudinal axis (unit,
 // proximal to distal) and length, for the angular-momentum term.
