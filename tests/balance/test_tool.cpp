@@ -188,4 +188,17 @@ TEST_CASE("tonus zmp --trunk straight: the trunk's mass on the hips-neck line, a
   CHECK(spine > 0);
   CHECK(straight > 0);
   CHECK(straight != spine);
+  // --both-trunks: the family twice, each member saying which trunk it has.
+  const std::string json = temp("both_trunks.json");
+  const Run both = run(clip + " --unit cmu --iterations 0 --both-trunks --json " + json);
+  CHECK(both.code != 2);
+  CHECK(both.out.find("12 Hz full (straight trunk)") != std::string::npos);
+  const std::string text = read_file(json);
+  const auto count = [&](const std::string& what) {
+    std::size_t k = 0;
+    for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++k;
+    return k;
+  };
+  CHECK(count("\"trunk\": \"spine\"") == 8);
+  CHECK(count("\"trunk\": \"straight\"") == 8);
 }

@@ -58,6 +58,9 @@ int run(int argc, char** argv) {
   zmp_cmd->add_option("--trunk", zmp.trunk,
                       "Where the trunk's mass lies: spine (along the spine joints, default) or straight (one rigid "
                       "trunk from the hips to the neck)");
+  zmp_cmd->add_flag("--both-trunks", zmp.both_trunks,
+                    "Judge under the estimator family with the trunk along the spine and straight (16 members); the "
+                    "robust filter then corrects under both");
   zmp_cmd->add_option("--foot-length", zmp.foot_length_m, "Sole length, m (default: from the skeleton)")
       ->check(CLI::Range(0.05, 0.5));
   zmp_cmd->add_option("--ground-height", zmp.ground_height_m,

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <span>
 #include <sstream>
 #include <string>
 
@@ -69,6 +70,11 @@ void on_progress(int iteration, std::size_t outside, void* user) {
   std::fflush(stderr);
 }
 
+// A member with the trunk straight says so; the default (along the spine) is unmarked.
+const char* trunk_label(const balance::MemberVerdict& m) {
+  return m.trunk == balance::TrunkModel::straight ? " (straight trunk)" : "";
+}
+
 // One line per member: frames outside by more than the threshold, before -> after.
 void print_family(const balance::FamilyVerdict& before, const balance::FamilyVerdict& after) {
   if (after.members.empty()) return;
@@ -77,8 +83,8 @@ void print_family(const balance::FamilyVerdict& before, const balance::FamilyVer
   std::string line;
   for (std::size_t i = 0; i < after.members.size() && i < before.members.size(); ++i) {
     const balance::MemberVerdict& a = after.members[i];
-    line += fmt::format("{}{:g} Hz {} {} -> {}", i % 2 == 0 ? "    " : ", ", a.cutoff_hz, a.full ? "full" : "particle",
-                        before.members[i].outside, a.outside);
+    line += fmt::format("{}{:g} Hz {}{} {} -> {}", i % 2 == 0 ? "    " : ", ", a.cutoff_hz,
+                        a.full ? "full" : "particle", trunk_label(a), before.members[i].outside, a.outside);
     if (i % 2 == 1) {
       fmt::print("{}\n", line);
       line.clear();
@@ -86,8 +92,8 @@ void print_family(const balance::FamilyVerdict& before, const balance::FamilyVer
   }
   if (!line.empty()) fmt::print("{}\n", line);
   const balance::MemberVerdict& w = after.members[after.worst];
-  fmt::print("  worst estimator after: {:g} Hz {}, {} frames ({:.1f} %): {} (at most {:.0f} %)\n", w.cutoff_hz,
-             w.full ? "full" : "particle", w.outside, 100.0 * w.share(),
+  fmt::print("  worst estimator after: {:g} Hz {}{}, {} frames ({:.1f} %): {} (at most {:.0f} %)\n", w.cutoff_hz,
+             w.full ? "full" : "particle", trunk_label(w), w.outside, 100.0 * w.share(),
              after.balanced() ? "balanced" : "NOT balanced under every estimator",
              100.0 * balance::kFamilyAllowedShare);
 }
@@ -226,6 +232,7 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
     ro.analysis = ao;
     if (opt.margin_m >= 0.0) ro.margin_m = opt.margin_m;
     ro.max_iterations = opt.max_iterations;
+    ro.both_trunks = opt.both_trunks;
     balance::RobustFilterResult robust = balance::robust_balance_filter(conv.motion, ro, on_progress, &progress);
     if (progress.show) fmt::print(stderr, "\n");
     if (!robust.ok()) return fail(robust.error);
@@ -248,7 +255,10 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
 
   // The original and the written clip, read back as a user would, under every
   // estimator of the family: the filter's own figures are one member's.
-  const std::vector<balance::AnalysisOptions> members = balance::estimator_family(ao);
+  const std::array<balance::TrunkModel, 2> trunks{
+      ao.trunk, ao.trunk == balance::TrunkModel::spine ? balance::TrunkModel::straight : balance::TrunkModel::spine};
+  const std::vector<balance::AnalysisOptions> members =
+      balance::estimator_family(ao, std::span<const balance::TrunkModel>(trunks.data(), opt.both_trunks ? 2U : 1U));
   const balance::FamilyVerdict family_before =
       balance::family_verdict(balance::analyse_family(conv.motion, members, result.before.contacts), members);
   const balance::Conversion written = balance::convert_motion(applied.clip, mapping, convert);

@@ -23,6 +23,7 @@ struct ZmpCommandOptions {
   double body_mass_kg = 70.0;
   std::string sex = "male";
   std::string trunk = "spine";
+  bool both_trunks = false;
   std::optional<double> foot_length_m;
   std::optional<double> ground_height_m;
   double contact_height_m = 0.025;

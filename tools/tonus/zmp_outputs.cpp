@@ -93,9 +93,11 @@ std::string family_json(const balance::FamilyVerdict* before, const balance::Fam
     const balance::MemberVerdict& b = before->members[i];
     const balance::MemberVerdict& a = after->members[i];
     out += fmt::format(
-        "{}\n    {{\"cutoff_hz\": {}, \"form\": \"{}\", \"supported_frames\": {}, \"outside_before\": {}, "
-        "\"outside_after\": {}, \"max_outside_before_m\": {:.6f}, \"max_outside_after_m\": {:.6f}}}",
-        i == 0 ? "" : ",", a.cutoff_hz, a.full ? "full" : "particle", a.supported, b.outside, a.outside,
+        "{}\n    {{\"cutoff_hz\": {}, \"form\": \"{}\", \"trunk\": \"{}\", \"supported_frames\": {}, "
+        "\"outside_before\": {}, \"outside_after\": {}, \"max_outside_before_m\": {:.6f}, \"max_outside_after_m\": "
+        "{:.6f}}}",
+        i == 0 ? "" : ",", a.cutoff_hz, a.full ? "full" : "particle",
+        a.trunk == balance::TrunkModel::straight ? "straight" : "spine", a.supported, b.outside, a.outside,
         b.max_outside_m, a.max_outside_m);
   }
   out += after->members.empty() ? "],\n" : "\n  ],\n";

@@ -25,6 +25,16 @@ std::vector<AnalysisOptions> estimator_family(const AnalysisOptions& base) {
   return members;
 }
 
+std::vector<AnalysisOptions> estimator_family(const AnalysisOptions& base, std::span<const TrunkModel> trunks) {
+  std::vector<AnalysisOptions> members;
+  for (const TrunkModel trunk : trunks) {
+    AnalysisOptions b = base;
+    b.trunk = trunk;
+    for (const AnalysisOptions& o : estimator_family(b)) members.push_back(o);
+  }
+  return members;
+}
+
 std::vector<Analysis> analyse_family(const HumanMotion& motion, const std::vector<AnalysisOptions>& members,
                                      const ContactTrack& contacts) {
   std::vector<Analysis> out(members.size());
@@ -70,6 +80,7 @@ FamilyVerdict family_verdict(const std::vector<Analysis>& analyses, const std::v
     MemberVerdict mv;
     mv.cutoff_hz = members[i].derivatives.cutoff_hz;
     mv.full = members[i].angular_momentum;
+    mv.trunk = members[i].trunk;
     for (const FrameAnalysis& f : analyses[i].frames) {
       if (!f.analysed || f.airborne || !f.zmp_defined) continue;
       ++mv.supported;

@@ -4,7 +4,9 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <span>
 
 #include "accel_operator.hpp"
 #include "tonus/host/balance/zmp.hpp"
@@ -52,6 +54,7 @@ struct Layer {
 struct Member {
   AnalysisOptions options;
   AccelOperator op;
+  std::size_t model = 0;  // which placement of the segments (Corrected::segments) it sees
   // Full form: each segment's axis acceleration in the original (D applied to
   // its axis series), from which a correction's change of the segments' own
   // angular momentum rate is taken.
@@ -79,7 +82,7 @@ struct Corrected {
   std::vector<Vec3> rotation;
   std::vector<Vec2> shift;
   std::vector<MotionFrame> frames;
-  std::vector<SegmentFrame> segments;
+  std::vector<std::vector<SegmentFrame>> segments;  // [mass model][frame]
   std::vector<bool> changed;
   std::vector<bool> unreachable;
   double max_drop_m = 0.0;
@@ -99,6 +102,7 @@ struct Problem {
   const RobustFilterOptions& o;
   const std::vector<Member>& members;
   const std::vector<Analysis>& base;  // per member, the original
+  std::vector<std::size_t> models;    // per mass model, a member that has it
   std::vector<Layer> layers;
   std::vector<std::array<double, 2>> follow;  // per frame and leg: how much a swinging foot follows the pelvis
   Eigen::SparseMatrix<double> regulariser;    // the correction's cost, q' R q
@@ -167,7 +171,8 @@ Corrected correct(const Problem& p, const Eigen::VectorXd& q) {
   c.rotation.assign(n, Vec3::Zero());
   c.shift.assign(n, Vec2::Zero());
   c.frames = m.frames;
-  c.segments = p.base.front().segments;
+  c.segments.resize(p.models.size());
+  for (std::size_t k = 0; k < p.models.size(); ++k) c.segments[k] = p.base[p.models[k]].segments;
   c.changed.assign(n, false);
   c.unreachable.assign(n, false);
   for (std::size_t t = first; t < n; ++t) {
@@ -178,7 +183,8 @@ Corrected correct(const Problem& p, const Eigen::VectorXd& q) {
     double drop = 0.0;
     bool reachable = true;
     c.frames[t] = correct_waist(m.frames[t], c.rotation[t], c.shift[t], &drop, &reachable, p.follow[t]);
-    c.segments[t] = place_segments(p.base.front().mass, c.frames[t].p);
+    for (std::size_t k = 0; k < p.models.size(); ++k)
+      c.segments[k][t] = place_segments(p.base[p.models[k]].mass, c.frames[t].p);
     c.changed[t] = true;
     c.unreachable[t] = !reachable;
     c.max_drop_m = std::max(c.max_drop_m, std::abs(drop));
@@ -272,12 +278,12 @@ Evaluation evaluate(const Problem& p, const Eigen::VectorXd& q) {
   for (std::size_t mi = 0; mi < count; ++mi) {
     const Analysis& a = p.base[mi];
     const AccelOperator& op = p.members[mi].op;
+    const std::vector<SegmentFrame>& segments = e.motion.segments[p.members[mi].model];
     auto& acc = e.acc[mi];
     acc = a.accelerations;
     // a(x + dx) = a(x) + D dx: only the changed frames contribute.
-    add_operator_change(op, changed, first, acc.data() + first, [&](std::size_t j, std::size_t i) {
-      return Vec3(e.motion.segments[j][i].com - a.segments[j][i].com);
-    });
+    add_operator_change(op, changed, first, acc.data() + first,
+                        [&](std::size_t j, std::size_t i) { return Vec3(segments[j][i].com - a.segments[j][i].com); });
     // Full form: the segments' own angular momentum rate, m rg^2 axis x axis'',
     // changes with their axes; the original's rate plus that change.
     std::vector<Vec3> rate;
@@ -286,11 +292,11 @@ Evaluation evaluate(const Problem& p, const Eigen::VectorXd& q) {
       rate = a.angular_momentum_rate;
       std::vector<std::array<Vec3, kSegmentParts>> axis_acc = mem.axis_acc;
       add_operator_change(op, changed, first, axis_acc.data(), [&](std::size_t j, std::size_t i) {
-        return Vec3(e.motion.segments[j][i].axis - a.segments[j][i].axis);
+        return Vec3(segments[j][i].axis - a.segments[j][i].axis);
       });
       for (std::size_t t = first; t < n; ++t) {
         for (std::size_t i = 0; i < kSegmentParts; ++i) {
-          rate[t] += segment_angular_momentum(a.mass, i, e.motion.segments[t][i], axis_acc[t - first][i]) -
+          rate[t] += segment_angular_momentum(a.mass, i, segments[t][i], axis_acc[t - first][i]) -
                      segment_angular_momentum(a.mass, i, a.segments[t][i], mem.axis_acc[t - first][i]);
         }
       }
@@ -301,7 +307,7 @@ Evaluation evaluate(const Problem& p, const Eigen::VectorXd& q) {
       const FrameAnalysis& f = a.frames[t];
       if (!f.analysed || f.airborne) continue;
       ZmpInputs in;
-      in.segments = &e.motion.segments[t];
+      in.segments = &segments[t];
       in.accel = &acc[t];
       in.angular_momentum_rate = rate.empty() ? a.angular_momentum_rate[t] : rate[t];
       const ZmpResult z = zero_moment_point(a.mass, in, a.contacts.ground_z_m, p.members[mi].options.gravity);
@@ -378,7 +384,9 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
     return r;
   }
   const ContactTrack& contacts = detected.contacts;  // the feet do not move: neither do their contacts
-  r.members = estimator_family(o.analysis);
+  const TrunkModel other = o.analysis.trunk == TrunkModel::spine ? TrunkModel::straight : TrunkModel::spine;
+  const std::array<TrunkModel, 2> trunks{o.analysis.trunk, other};
+  r.members = estimator_family(o.analysis, std::span<const TrunkModel>(trunks.data(), o.both_trunks ? 2U : 1U));
   r.before = analyse_family(motion, r.members, contacts);
   for (const Analysis& a : r.before) {
     if (!a.ok()) {
@@ -389,8 +397,12 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
   r.verdict_before = family_verdict(r.before, r.members);
   const std::size_t m = n - first;
   std::vector<Member> members;
+  std::vector<std::size_t> models;  // per trunk model met, its first member
   for (const AnalysisOptions& mo : r.members) {
-    members.push_back({mo, detail::accel_operator(m, motion.dt_s, mo.derivatives), {}});
+    std::size_t model = 0;
+    while (model < models.size() && r.members[models[model]].trunk != mo.trunk) ++model;
+    if (model == models.size()) models.push_back(members.size());
+    members.push_back({mo, detail::accel_operator(m, motion.dt_s, mo.derivatives), model, {}});
     if (mo.angular_momentum) {
       const Analysis& base = r.before[members.size() - 1];
       members.back().axis_acc = apply_operator(members.back().op, first,
@@ -399,7 +411,7 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
     r.lookahead_frames = std::max(r.lookahead_frames, members.back().op.band);
   }
 
-  Problem p{motion, o, members, r.before, {}, follow_weights(motion, contacts, o.swing_follow_ramp_s), {}};
+  Problem p{motion, o, members, r.before, models, {}, follow_weights(motion, contacts, o.swing_follow_ramp_s), {}};
   // The balance layer (lean, yaw, shift) and the fine layer (a few millimetres
   // of shift, fast enough to take the capture's jitter out of the centre of mass).
   std::vector<std::size_t> imbalanced;  // frames (from the first analysed) outside under some member
@@ -453,7 +465,8 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
   for (r.iterations = 0; r.iterations < o.max_iterations; ++r.iterations) {
     if (progress != nullptr) progress(r.iterations, worst_outside(now, kFamilyThreshold_m), user);
     // Each frame's segments under a small change of each of its correction's components.
-    std::vector<std::array<std::array<Vec3, kSegmentParts>, kDof>> dcom(n), daxis(n);
+    using FrameDerivative = std::vector<std::array<std::array<Vec3, kSegmentParts>, kDof>>;  // [frame][dof][part]
+    std::vector<FrameDerivative> dcom(models.size(), FrameDerivative(n)), daxis(models.size(), FrameDerivative(n));
     std::vector<bool> needed(n, false);
     for (std::size_t mi = 0; mi < members.size(); ++mi) {
       for (std::size_t t = first; t < n; ++t) {
@@ -474,12 +487,13 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
           rot(static_cast<Eigen::Index>(e)) += h;
         else
           sh(static_cast<Eigen::Index>(e - 3)) += h;
-        const SegmentFrame moved = place_segments(
-            r.before.front().mass, correct_waist(motion.frames[t], rot, sh, nullptr, nullptr, p.follow[t]).p);
-        for (std::size_t i = 0; i < kSegmentParts; ++i)
-          dcom[t][e][i] = (moved[i].com - now.motion.segments[t][i].com) / h;
-        for (std::size_t i = 0; i < kSegmentParts; ++i)
-          daxis[t][e][i] = (moved[i].axis - now.motion.segments[t][i].axis) / h;
+        const MotionFrame probe = correct_waist(motion.frames[t], rot, sh, nullptr, nullptr, p.follow[t]);
+        for (std::size_t k = 0; k < models.size(); ++k) {
+          const SegmentFrame moved = place_segments(r.before[models[k]].mass, probe.p);
+          const SegmentFrame& at = now.motion.segments[k][t];
+          for (std::size_t i = 0; i < kSegmentParts; ++i) dcom[k][t][e][i] = (moved[i].com - at[i].com) / h;
+          for (std::size_t i = 0; i < kSegmentParts; ++i) daxis[k][t][e][i] = (moved[i].axis - at[i].axis) / h;
+        }
       }
     }
     if (!any) break;  // no frame near an edge under any member: nothing to correct
@@ -493,13 +507,14 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
     for (std::size_t mi = 0; mi < members.size(); ++mi) {
       const Analysis& a = r.before[mi];
       const AccelOperator& op = members[mi].op;
+      const std::size_t model = members[mi].model;
+      const std::vector<SegmentFrame>& segments = now.motion.segments[model];
       for (std::size_t t = first; t < n; ++t) {
         const double viol = now.distance[mi][t] + o.margin_m;
         if (viol <= 0.0) continue;
         const Vec2 normal = distance_gradient(a.frames[t].support, now.zmp[mi][t]);
-        const detail::ZmpPartials dp =
-            detail::zmp_partials(a.mass, now.motion.segments[t], now.acc[mi][t], now.zmp[mi][t], a.contacts.ground_z_m,
-                                 members[mi].options.gravity);
+        const detail::ZmpPartials dp = detail::zmp_partials(a.mass, segments[t], now.acc[mi][t], now.zmp[mi][t],
+                                                            a.contacts.ground_z_m, members[mi].options.gravity);
         std::array<Eigen::RowVector3d, kSegmentParts> along_pos, along_acc;
         for (std::size_t i = 0; i < kSegmentParts; ++i) {
           along_pos[i] = normal.transpose() * dp.dpos[i];
@@ -516,8 +531,7 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
           const Vec3 r_vec = Vec3(normal.y(), -normal.x(), 0.0) / big_n;
           for (std::size_t i = 0; i < kSegmentParts; ++i)
             for (Eigen::Index c = 0; c < 3; ++c)
-              along_axis_acc[i](c) =
-                  r_vec.dot(segment_angular_momentum(a.mass, i, now.motion.segments[t][i], Vec3::Unit(c)));
+              along_axis_acc[i](c) = r_vec.dot(segment_angular_momentum(a.mass, i, segments[t][i], Vec3::Unit(c)));
         }
         const std::size_t kk = t - first;
         const std::size_t lo = kk > op.band ? kk - op.band : 0, hi = std::min(m - 1, kk + op.band);
@@ -528,10 +542,10 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
           std::array<double, kDof> g{};
           for (std::size_t e = 0; e < kDof; ++e) {
             for (std::size_t i = 0; i < kSegmentParts; ++i) {
-              const Vec3& dc = dcom[first + jj][e][i];
+              const Vec3& dc = dcom[model][first + jj][e][i];
               g[e] += w * along_acc[i].dot(dc);
               if (jj == kk) g[e] += along_pos[i].dot(dc);
-              if (full) g[e] += w * along_axis_acc[i].dot(daxis[first + jj][e][i]);
+              if (full) g[e] += w * along_axis_acc[i].dot(daxis[model][first + jj][e][i]);
             }
           }
           for (const Layer& l : p.layers) {

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstddef>
+#include <span>
 #include <vector>
 
 #include "tonus/host/balance/analysis.hpp"
@@ -25,6 +26,9 @@ inline constexpr double kFamilyAllowedShare = 0.02;
 
 // `base` with each cut-off, particle then full form (everything else as given).
 std::vector<AnalysisOptions> estimator_family(const AnalysisOptions& base);
+// The same for each trunk model in turn (mass_model.hpp): the estimators'
+// spread in where the trunk's mass lies, beside their smoothing's.
+std::vector<AnalysisOptions> estimator_family(const AnalysisOptions& base, std::span<const TrunkModel> trunks);
 
 // Every member's analysis on the same contacts. The segments are placed once
 // and differentiated once per cut-off: the cost is about the cut-offs', not
@@ -35,6 +39,7 @@ std::vector<Analysis> analyse_family(const HumanMotion& motion, const std::vecto
 struct MemberVerdict {
   double cutoff_hz = 0.0;
   bool full = false;
+  TrunkModel trunk = TrunkModel::spine;
   std::size_t supported = 0;  // analysed frames with a foot down and the ZMP defined
   std::size_t outside = 0;    // of those, outside by more than the threshold
   double max_outside_m = 0.0;

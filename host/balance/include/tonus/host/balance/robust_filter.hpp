@@ -61,6 +61,10 @@ struct RobustFilterOptions {
   double local_reach_s = 0.1;
   double far_weight = 10.0;
   int max_iterations = 40;
+  // The family answers to each of these trunk models (mass_model.hpp): the
+  // analysis's own alone, or both. Where the trunk's mass lies moves the ZMP
+  // by centimetres on lively clips, as much as the smoothing does.
+  bool both_trunks = false;
 };
 
 struct RobustFilterResult {
