@@ -62,7 +62,7 @@ void filter(benchmark::State& state, const std::string& path) {
   state.counters["solver_iterations"] = static_cast<double>(iterations);
 }
 
-void robust_filter(benchmark::State& state, const std::string& path) {
+void robust_filter(benchmark::State& state, const std::string& path, bool both_trunks) {
   bool ok = false;
   const balance::HumanMotion m = load(path, ok);
   if (!ok) {
@@ -71,7 +71,9 @@ void robust_filter(benchmark::State& state, const std::string& path) {
   }
   std::size_t lookahead = 0, iterations = 0, worst = 0;
   for (auto _ : state) {  // NOLINT(clang-analyzer-deadcode.DeadStores): Google Benchmark's loop idiom
-    const balance::RobustFilterResult f = balance::robust_balance_filter(m, balance::RobustFilterOptions{});
+    balance::RobustFilterOptions options;
+    options.both_trunks = both_trunks;  // the family with the trunk along the spine and straight
+    const balance::RobustFilterResult f = balance::robust_balance_filter(m, options);
     lookahead = f.lookahead_frames;
     iterations = static_cast<std::size_t>(f.iterations);
     worst = f.verdict_after.members.empty() ? 0 : f.verdict_after.members[f.verdict_after.worst].outside;
@@ -132,8 +134,10 @@ BENCHMARK_CAPTURE(analyse, bandai_walk_30hz, kBandaiWalk)->Unit(benchmark::kMill
 BENCHMARK_CAPTURE(filter, cmu_walk_120hz, kCmuWalk)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(filter, bandai_walk_30hz, kBandaiWalk)->Unit(benchmark::kMillisecond);
 
-BENCHMARK_CAPTURE(robust_filter, cmu_walk_120hz, kCmuWalk)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(robust_filter, bandai_walk_30hz, kBandaiWalk)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(robust_filter, cmu_walk_120hz, kCmuWalk, false)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(robust_filter, bandai_walk_30hz, kBandaiWalk, false)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(robust_filter, cmu_walk_120hz_both_trunks, kCmuWalk, true)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(robust_filter, bandai_walk_30hz_both_trunks, kBandaiWalk, true)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(online_filter, cmu_walk_120hz, kCmuWalk)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(online_filter, bandai_kicks_30hz,
                   std::string(TONUS_SHARED_DATA_DIR) + "/bvh/dataset-1_kick_normal_001.bvh")
