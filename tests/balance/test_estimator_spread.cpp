@@ -31,17 +31,26 @@ Spread spread_of(std::vector<double> d, const Vec2& sum) {
   return {d[d.size() / 2], d[d.size() * 95 / 100], sum / static_cast<double>(d.size())};
 }
 
+// The independent estimator's view of a loaded clip.
+indep::Estimate independent_estimate(const test::Loaded& l, double unit_m) {
+  indep::Options io;
+  io.metres_per_unit = unit_m;
+  io.first_frame = l.conversion.motion.first_frame;
+  indep::Estimate e = indep::estimate_zmp(l.clip, io);
+  REQUIRE(e.ok());
+  return e;
+}
+
+// Its ZMP in the tool's frame: its x is the file's x, its y is -z; the tool's x is z, its y is x.
+Vec2 in_tool_frame(const indep::FrameEstimate& f) { return {-f.zmp.y(), f.zmp.x()}; }
+
 void check_spread(const std::string& name, const std::string& path, double unit_m) {
   const test::Loaded l = test::load(path);
   const AnalysisOptions base;
   const std::vector<AnalysisOptions> members = estimator_family(base);
   const std::vector<Analysis> family =
       analyse_family(l.conversion.motion, members, detect_contacts(l.conversion.motion, base.contacts));
-  indep::Options io;
-  io.metres_per_unit = unit_m;
-  io.first_frame = l.conversion.motion.first_frame;
-  const indep::Estimate e = indep::estimate_zmp(l.clip, io);
-  REQUIRE(e.ok());
+  const indep::Estimate e = independent_estimate(l, unit_m);
   std::size_t ref = members.size();
   for (std::size_t m = 0; m < members.size(); ++m) {
     if (members[m].derivatives.cutoff_hz == base.derivatives.cutoff_hz &&
@@ -49,8 +58,6 @@ void check_spread(const std::string& name, const std::string& path, double unit_
       ref = m;
   }
   REQUIRE(ref < members.size());
-  // The independent estimator's frame: x = the file's x, y = -z; the tool's: x = z, y = x.
-  const auto independent_zmp = [&](std::size_t t) { return Vec2(-e.frames[t].zmp.y(), e.frames[t].zmp.x()); };
   const auto usable = [&](std::size_t t) {
     const FrameAnalysis& r = family[ref].frames[t];
     return r.analysed && !r.airborne && r.zmp_defined && e.frames[t].supported && e.frames[t].zmp_defined;
@@ -59,7 +66,7 @@ void check_spread(const std::string& name, const std::string& path, double unit_
   Vec2 sum = Vec2::Zero();
   for (std::size_t t = 0; t < e.frames.size(); ++t) {
     if (!usable(t)) continue;
-    const Vec2 diff = independent_zmp(t) - family[ref].frames[t].zmp;
+    const Vec2 diff = in_tool_frame(e.frames[t]) - family[ref].frames[t].zmp;
     d.push_back(diff.norm());
     sum += diff;
   }
@@ -94,11 +101,7 @@ void check_spread(const std::string& name, const std::string& path, double unit_
 // estimate with each trunk model, over the frames both find supported.
 std::array<double, 2> trunk_medians(const std::string& name, const std::string& path, double unit_m) {
   const test::Loaded l = test::load(path);
-  indep::Options io;
-  io.metres_per_unit = unit_m;
-  io.first_frame = l.conversion.motion.first_frame;
-  const indep::Estimate e = indep::estimate_zmp(l.clip, io);
-  REQUIRE(e.ok());
+  const indep::Estimate e = independent_estimate(l, unit_m);
   std::array<double, 2> medians{};
   for (const TrunkModel trunk : {TrunkModel::spine, TrunkModel::straight}) {
     AnalysisOptions o;
@@ -109,7 +112,7 @@ std::array<double, 2> trunk_medians(const std::string& name, const std::string& 
     for (std::size_t t = 0; t < e.frames.size(); ++t) {
       const FrameAnalysis& r = a.frames[t];
       if (!r.analysed || r.airborne || !r.zmp_defined || !e.frames[t].supported || !e.frames[t].zmp_defined) continue;
-      d.push_back((Vec2(-e.frames[t].zmp.y(), e.frames[t].zmp.x()) - r.zmp).norm());
+      d.push_back((in_tool_frame(e.frames[t]) - r.zmp).norm());
     }
     medians[trunk == TrunkModel::spine ? 0 : 1] = spread_of(d, Vec2::Zero()).median_m;
   }

@@ -6,7 +6,6 @@
 #include <array>
 #include <cmath>
 #include <fstream>
-#include <span>
 #include <sstream>
 #include <string>
 
@@ -255,10 +254,7 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
 
   // The original and the written clip, read back as a user would, under every
   // estimator of the family: the filter's own figures are one member's.
-  const std::array<balance::TrunkModel, 2> trunks{
-      ao.trunk, ao.trunk == balance::TrunkModel::spine ? balance::TrunkModel::straight : balance::TrunkModel::spine};
-  const std::vector<balance::AnalysisOptions> members =
-      balance::estimator_family(ao, std::span<const balance::TrunkModel>(trunks.data(), opt.both_trunks ? 2U : 1U));
+  const std::vector<balance::AnalysisOptions> members = balance::estimator_family(ao, opt.both_trunks);
   const balance::FamilyVerdict family_before =
       balance::family_verdict(balance::analyse_family(conv.motion, members, result.before.contacts), members);
   const balance::Conversion written = balance::convert_motion(applied.clip, mapping, convert);

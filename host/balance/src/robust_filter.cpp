@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <span>
 
 #include "accel_operator.hpp"
 #include "tonus/host/balance/zmp.hpp"
@@ -384,9 +383,7 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
     return r;
   }
   const ContactTrack& contacts = detected.contacts;  // the feet do not move: neither do their contacts
-  const TrunkModel other = o.analysis.trunk == TrunkModel::spine ? TrunkModel::straight : TrunkModel::spine;
-  const std::array<TrunkModel, 2> trunks{o.analysis.trunk, other};
-  r.members = estimator_family(o.analysis, std::span<const TrunkModel>(trunks.data(), o.both_trunks ? 2U : 1U));
+  r.members = estimator_family(o.analysis, o.both_trunks);
   r.before = analyse_family(motion, r.members, contacts);
   for (const Analysis& a : r.before) {
     if (!a.ok()) {

@@ -9,7 +9,6 @@
 
 #include <array>
 #include <cstddef>
-#include <span>
 #include <vector>
 
 #include "tonus/host/balance/analysis.hpp"
@@ -26,13 +25,14 @@ inline constexpr double kFamilyAllowedShare = 0.02;
 
 // `base` with each cut-off, particle then full form (everything else as given).
 std::vector<AnalysisOptions> estimator_family(const AnalysisOptions& base);
-// The same for each trunk model in turn (mass_model.hpp): the estimators'
-// spread in where the trunk's mass lies, beside their smoothing's.
-std::vector<AnalysisOptions> estimator_family(const AnalysisOptions& base, std::span<const TrunkModel> trunks);
+// With both_trunks, followed by the same with the other trunk model
+// (mass_model.hpp): the estimators' spread in where the trunk's mass lies,
+// beside their smoothing's.
+std::vector<AnalysisOptions> estimator_family(const AnalysisOptions& base, bool both_trunks);
 
 // Every member's analysis on the same contacts. The segments are placed once
-// and differentiated once per cut-off: the cost is about the cut-offs', not
-// the members'. An error in any member is every member's error.
+// per trunk model and differentiated once per cut-off and trunk: the cost is
+// about those, not the members'. An error in any member is every member's error.
 std::vector<Analysis> analyse_family(const HumanMotion& motion, const std::vector<AnalysisOptions>& members,
                                      const ContactTrack& contacts);
 
