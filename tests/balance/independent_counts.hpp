@@ -6,9 +6,12 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <vector>
 
+#include "independent/skeleton.hpp"
 #include "independent/zmp_estimator.hpp"
 #include "tonus/host/motion/clip.hpp"
 
@@ -73,6 +76,41 @@ inline ContactTiming contact_timing(const motion::Clip& written, double unit_m, 
   const indep::Estimate f = indep::estimate_zmp(written, fast);
   REQUIRE(f.ok());
   c.outside_fast_landing = f.summary.outside;
+  return c;
+}
+
+// How smoothly a correction moves the pelvis up and down, read from the
+// written file by the independent estimator's own skeleton and forward
+// kinematics: the midpoint of the hip joints (the filters' pivot, which lean
+// and yaw leave in place) minus the original's, its second difference over
+// dt^2 from `first_frame` on: the vertical acceleration the correction adds.
+struct PelvisHeightChange {
+  double max_m = 0.0;           // the largest lowering or raising
+  double max_accel_mps2 = 0.0;  // its largest acceleration
+  double p99_accel_mps2 = 0.0;  // and the 99th percentile
+};
+
+inline PelvisHeightChange pelvis_height_change(const motion::Clip& original, const motion::Clip& written, double unit_m,
+                                               std::size_t first_frame) {
+  const indep::SkeletonMap map = indep::map_skeleton(original);
+  REQUIRE_MESSAGE(map.ok(), map.error);
+  const std::vector<indep::Sites> a = indep::site_positions(original, map, unit_m, first_frame),
+                                  b = indep::site_positions(written, map, unit_m, first_frame);
+  REQUIRE(a.size() == b.size());
+  std::vector<double> dz(a.size());
+  PelvisHeightChange c;
+  for (std::size_t t = 0; t < a.size(); ++t) {
+    const auto mid = [](const indep::Sites& s) { return 0.5 * (s[indep::left_hip].z() + s[indep::right_hip].z()); };
+    dz[t] = mid(b[t]) - mid(a[t]);
+    c.max_m = std::max(c.max_m, std::abs(dz[t]));
+  }
+  std::vector<double> accel;
+  const double dt2 = original.frame_time_s * original.frame_time_s;
+  for (std::size_t t = 1; t + 1 < dz.size(); ++t) accel.push_back(std::abs(dz[t + 1] - 2.0 * dz[t] + dz[t - 1]) / dt2);
+  if (accel.empty()) return c;
+  std::sort(accel.begin(), accel.end());
+  c.max_accel_mps2 = accel.back();
+  c.p99_accel_mps2 = accel[static_cast<std::size_t>(0.99 * static_cast<double>(accel.size() - 1))];
   return c;
 }
 

@@ -53,8 +53,8 @@ TEST_CASE("tonus zmp --correction rotation: corrects the bundled walk and writes
   const std::string json = read_file(temp("walk.json"));
   for (const char* key :
        {"\"frames\"", "\"frames_outside_before\"", "\"frames_outside_after\": 0,", "\"max_outside_before_m\"",
-        "\"max_outside_after_m\"", "\"max_foot_displacement_m\"", "\"rms_joint_change_rad\"", "\"frames_unsolved\": 0,",
-        "\"frames_airborne\"", "\"rms_change_changed_joints_rad\"", "\"changed_joints\": 7,",
+        "\"max_outside_after_m\"", "\"max_foot_displacement_m\"", "\"max_pelvis_drop_m\"", "\"rms_joint_change_rad\"",
+        "\"frames_unsolved\": 0,", "\"frames_airborne\"", "\"rms_change_changed_joints_rad\"", "\"changed_joints\": 7,",
         "\"changed_joint_frames\"", "\"max_change_per_joint\": {",
         "\"Hips\": {\"bone\": \"Hips\", \"max_rad\": ", "\"LeftUpLeg\": {\"bone\": \"LeftUpperLeg\", \"max_rad\": "}) {
     CHECK_MESSAGE(json.find(key) != std::string::npos, key);

@@ -109,6 +109,7 @@ balance::FilterResult as_filter_result(balance::RobustFilterResult&& r, const ba
   f.correction = std::move(r.rotation);
   f.shift_m = std::move(r.shift_m);
   f.follow = std::move(r.follow);
+  f.drop_m = std::move(r.drop_m);
   f.unsolved = std::move(r.unsolved);
   f.frames_unsolved = r.frames_unsolved;
   f.max_foot_displacement_m = r.max_foot_displacement_m;
@@ -138,6 +139,7 @@ bool online_result(const balance::HumanMotion& motion, const balance::AnalysisOp
   f.corrected = std::move(run.corrected);
   f.correction.assign(motion.size(), balance::Vec3::Zero());
   f.shift_m = std::move(run.shift_m);
+  f.drop_m = std::move(run.drop_m);
   f.unsolved.assign(motion.size(), false);
   f.max_drop_m = run.max_drop_m;
   cost_us = {run.mean_push_us, run.max_push_us};
@@ -243,8 +245,8 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
   }
   if (!result.ok()) return fail(result.error);
 
-  balance::AppliedCorrection applied =
-      balance::apply_correction(read.clip, conv.geometry, conv.motion, result.correction, shift_m, result.follow);
+  balance::AppliedCorrection applied = balance::apply_correction(
+      read.clip, conv.geometry, conv.motion, result.correction, shift_m, result.follow, result.drop_m);
   if (!applied.ok()) return fail(applied.error);
   if (!opt.output.empty()) {
     std::ofstream out(opt.output, std::ios::binary);
@@ -311,9 +313,9 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
       for (const balance::Vec2& s : shift_m) shift = std::max(shift, s.norm());
       fmt::print(
           "  correction (online, look-ahead {:.3f} s = {} frames, window smoothing {:g} Hz): pelvis shift up to {:.1f} "
-          "cm; feet down moved by at most {:.2e} m; {:.0f} us per frame (max {:.0f} us)\n",
-          opt.lookahead_s, result.operator_band, opt.window_cutoff_hz, 100.0 * shift, applied.max_foot_displacement_m,
-          online_cost_us[0], online_cost_us[1]);
+          "cm, lowered up to {:.1f} mm; feet down moved by at most {:.2e} m; {:.0f} us per frame (max {:.0f} us)\n",
+          opt.lookahead_s, result.operator_band, opt.window_cutoff_hz, 100.0 * shift, 1000.0 * result.max_drop_m,
+          applied.max_foot_displacement_m, online_cost_us[0], online_cost_us[1]);
     } else if (shift_m.empty()) {
       fmt::print("  correction: waist rotation up to {:.3f} rad, feet moved by at most {:.2e} m, {} iterations\n",
                  report.max_correction_rad, applied.max_foot_displacement_m, result.iterations);
@@ -325,10 +327,12 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
         shift = std::max(shift, shift_m[t].norm());
       }
       fmt::print(
-          "  correction: lean up to {:.1f} deg, yaw up to {:.1f} deg, pelvis shift up to {:.1f} cm; feet down moved by "
-          "at most {:.2e} m, feet in the air followed the pelvis by up to {:.1f} cm; {} iterations\n",
-          lean * 180.0 / M_PI, yaw * 180.0 / M_PI, 100.0 * shift, applied.max_foot_displacement_m,
-          100.0 * applied.max_swing_foot_displacement_m, result.iterations);
+          "  correction: lean up to {:.1f} deg, yaw up to {:.1f} deg, pelvis shift up to {:.1f} cm, lowered up to "
+          "{:.1f} "
+          "mm; feet down moved by at most {:.2e} m, feet in the air followed the pelvis by up to {:.1f} cm; {} "
+          "iterations\n",
+          lean * 180.0 / M_PI, yaw * 180.0 / M_PI, 100.0 * shift, 1000.0 * result.max_drop_m,
+          applied.max_foot_displacement_m, 100.0 * applied.max_swing_foot_displacement_m, result.iterations);
     }
     // Only the joints and frames changed count, so the figure is the edit's real size.
     std::string largest;

@@ -27,7 +27,8 @@ Quatd local_from(const std::vector<motion::JointPose>& poses, const std::vector<
 
 AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeometry& g, const HumanMotion& human,
                                    const std::vector<Vec3>& correction, const std::vector<Vec2>& shift_m,
-                                   const std::vector<std::array<double, 2>>& follow) {
+                                   const std::vector<std::array<double, 2>>& follow,
+                                   const std::vector<double>& drop_m) {
   const std::size_t first_frame = human.first_frame;
   AppliedCorrection out;
   out.clip = clip;
@@ -42,7 +43,8 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
   }
   if (correction.size() != clip.frame_count || human.size() != clip.frame_count ||
       (!shift_m.empty() && shift_m.size() != clip.frame_count) ||
-      (!follow.empty() && follow.size() != clip.frame_count)) {
+      (!follow.empty() && follow.size() != clip.frame_count) ||
+      (!drop_m.empty() && drop_m.size() != clip.frame_count)) {
     out.error = "one correction per frame is needed";
     return out;
   }
@@ -64,10 +66,11 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
       return out;
     }
     const Vec2 shift = shift_m.empty() ? Vec2::Zero() : shift_m[f];
-    if (f < first_frame || (correction[f].norm() == 0.0 && shift.norm() == 0.0)) continue;
+    const double least_drop = drop_m.empty() ? 0.0 : drop_m[f];
+    if (f < first_frame || (correction[f].norm() == 0.0 && shift.norm() == 0.0 && least_drop == 0.0)) continue;
     // The same turn, shift and drop the filter used, in the file's frame and units.
-    const WaistTurn turn =
-        waist_turn(human.frames[f], correction[f], shift, follow.empty() ? std::array<double, 2>{} : follow[f]);
+    const WaistTurn turn = waist_turn(human.frames[f], correction[f], shift,
+                                      follow.empty() ? std::array<double, 2>{} : follow[f], least_drop);
     const Quatd r = to_int.conjugate() * turn.rotation * to_int;
     const Vec3d pivot = to_int.conjugate() * turn.pivot / g.metres_per_unit;
     const Vec3d drop = to_int.conjugate() * Vec3d(turn.shift.x(), turn.shift.y(), -turn.drop_m) / g.metres_per_unit;

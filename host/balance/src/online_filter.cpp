@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <span>
 #include <utility>
 
 #include "constrained_preview.hpp"
+#include "drop_envelope.hpp"
 #include "tonus/host/balance/filter.hpp"
 #include "tonus/host/balance/zmp.hpp"
 
@@ -13,6 +15,10 @@ namespace tonus::balance {
 namespace {
 
 constexpr double kMaxDrop_m = 0.008;
+// How fast the drop follows its eased envelope (emit): measured 1.5, 2, 3
+// and 4 Hz on the shared clips (docs/balance.md); 3 Hz, within a frame or two
+// of the others' counts, has the smallest vertical accelerations at 30 Hz.
+constexpr double kDropFollowHz = 3.0;
 // The least weight of a frame's ZMP error (its support ratio, below).
 constexpr double kMinErrorWeight = 0.2;
 // The planner's support ratio: from that floor to this cap (a landing's
@@ -125,6 +131,9 @@ OnlineBalance::OnlineBalance(const OnlineOptions& options, std::size_t lag, cons
       ratio_(lag + 1, 1.0),
       outside_(lag + 1, 0.0),
       defined_(lag + 1, false) {
+  drop_envelope_ = std::make_unique<detail::DropEnvelope>(options.dt_s, lag);
+  past_need_.assign(drop_envelope_->reach() + 1, 0.0);
+  need_window_.assign(2 * drop_envelope_->reach() + 1, 0.0);
   for (ConvexPolygon& p : polygons_) p.vertices.reserve(kHullInlinePoints);
   errors_[0].assign(lag + 1, 0.0);
   errors_[1].assign(lag + 1, 0.0);
@@ -255,22 +264,57 @@ void OnlineBalance::emit(std::size_t frames_back, OnlineFrame& out) {
   }
   shift += fine;
   bool reachable = true;
-  out.corrected = correct_waist(f, Vec3::Zero(), shift, &out.drop_m, &reachable);
-  // A straight stance leg makes the pelvis drop to keep its foot; a drop that
-  // comes and goes within a frame or two is a vertical jolt whose
-  // acceleration throws the ZMP far off. Shift less there instead.
-  if (out.drop_m > kMaxDrop_m) {
+  double need = waist_turn(f, Vec3::Zero(), shift).drop_m;
+  // A straight stance leg makes the pelvis drop to keep its foot; more than
+  // a few millimetres is a plunge. Shift less there instead.
+  if (need > kMaxDrop_m) {
     double lo = 0.0, hi = 1.0;
     for (int i = 0; i < 6; ++i) {
       const double mid = 0.5 * (lo + hi);
-      double drop = 0.0;
-      (void)correct_waist(f, Vec3::Zero(), mid * shift, &drop, nullptr);
-      (drop > kMaxDrop_m ? hi : lo) = mid;
+      (waist_turn(f, Vec3::Zero(), mid * shift).drop_m > kMaxDrop_m ? hi : lo) = mid;
     }
     shift *= lo;
     out.shift_capped = true;
-    out.corrected = correct_waist(f, Vec3::Zero(), shift, &out.drop_m, &reachable);
+    need = waist_turn(f, Vec3::Zero(), shift).drop_m;
   }
+  // The drop comes and goes with a leg's straightening, within a frame or
+  // two: eased over the frames either side (drop_envelope.hpp), the needs of
+  // the ones already out as they went out, of the ones ahead under this shift.
+  const std::size_t reach = drop_envelope_->reach();
+  for (std::size_t j = 0; j < need_window_.size(); ++j) {
+    double v = 0.0;
+    if (j < reach) {  // before this frame: the need it went out with
+      const std::size_t back = reach - j;
+      if (back <= emitted_) v = past_need_[(emitted_ - back) % past_need_.size()];
+    } else if (j == reach) {
+      v = need;
+    } else if (j - reach <= frames_back) {  // ahead, within what has arrived, under this shift
+      v = waist_turn(frames_[(k + (j - reach)) % (lag_ + 1)], Vec3::Zero(), shift).drop_m;
+    }
+    need_window_[j] = std::max(v, 0.0);
+  }
+  past_need_[emitted_ % past_need_.size()] = std::max(need, 0.0);
+  // The needs ahead are foreseen under this frame's shift, and the shift
+  // moves on: a need foreseen on one frame may be gone on the next. The drop
+  // follows that envelope as a critically damped second-order system (exact
+  // steps), so a need foreseen for a frame or two moves it little; never
+  // below this frame's own need (the foot is kept), and from rest where that
+  // forces it.
+  const double target = drop_envelope_->at(need_window_.data(), need_window_.size(), reach);
+  double eased = target;
+  if (emitted_ > 0) {
+    const double omega = 2.0 * std::numbers::pi * kDropFollowHz, dt = options_.dt_s;
+    const double e0 = drop_state_[0] - target, v0 = drop_state_[1], b = v0 + omega * e0;
+    const double decay = std::exp(-omega * dt);
+    eased = target + (e0 + b * dt) * decay;
+    drop_state_[1] = (v0 - omega * b * dt) * decay;
+    if (need > eased) {
+      eased = need;
+      drop_state_[1] = 0.0;
+    }
+  }
+  drop_state_[0] = eased;
+  out.corrected = correct_waist(f, Vec3::Zero(), shift, &out.drop_m, &reachable, {}, eased);
   // Anti-windup: where the cap or the leg's reach held the shift back, the
   // cart goes on from where the body is, not from where it was asked to be
   // (else it overshoots when the limit lets go, which is a jolt).

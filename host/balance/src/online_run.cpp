@@ -15,6 +15,7 @@ OnlineRun run_online(const HumanMotion& motion, const OnlineOptions& options) {
   OnlineBalance& filter = *created.filter;
   run.corrected = motion;
   run.shift_m.assign(motion.size(), Vec2::Zero());
+  run.drop_m.assign(motion.size(), 0.0);
   run.lookahead_frames = filter.lookahead_frames();
   OnlineFrame out;
   // A leading T-pose is not part of the motion: fed to the filter it would
@@ -23,6 +24,7 @@ OnlineRun run_online(const HumanMotion& motion, const OnlineOptions& options) {
   const auto take = [&] {
     run.corrected.frames[first + out.index] = out.corrected;
     run.shift_m[first + out.index] = out.shift_m;
+    run.drop_m[first + out.index] = out.drop_m;
     run.max_drop_m = std::max(run.max_drop_m, out.drop_m);
   };
   double total_us = 0.0;

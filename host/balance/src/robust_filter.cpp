@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "accel_operator.hpp"
+#include "drop_envelope.hpp"
 #include "tonus/host/balance/zmp.hpp"
 #include "zmp_partials.hpp"
 
@@ -84,6 +85,7 @@ struct Corrected {
   std::vector<std::vector<SegmentFrame>> segments;  // [mass model][frame]
   std::vector<bool> changed;
   std::vector<bool> unreachable;
+  std::vector<double> drop;  // per frame: the pelvis lowered, smoothed over time (drop_envelope.hpp)
   double max_drop_m = 0.0;
 };
 
@@ -105,6 +107,7 @@ struct Problem {
   std::vector<Layer> layers;
   std::vector<std::array<double, 2>> follow;  // per frame and leg: how much a swinging foot follows the pelvis
   Eigen::SparseMatrix<double> regulariser;    // the correction's cost, q' R q
+  detail::DropEnvelope drop_envelope;
 };
 
 double smoothstep(double x) {
@@ -174,14 +177,23 @@ Corrected correct(const Problem& p, const Eigen::VectorXd& q) {
   for (std::size_t k = 0; k < p.models.size(); ++k) c.segments[k] = p.base[p.models[k]].segments;
   c.changed.assign(n, false);
   c.unreachable.assign(n, false);
+  // Each frame's turn and shift, and the drop its legs need; then the drop
+  // eased over time, so the pelvis does not jolt where a leg straightens.
+  std::vector<double> need(n, 0.0);
   for (std::size_t t = first; t < n; ++t) {
     const Eigen::Matrix<double, kDof, 1> v = frame_value(p, q, t - first);
     if (v.isZero(0.0)) continue;
     c.rotation[t] = v.head<3>();
     c.shift[t] = v.tail<2>();
+    need[t] = std::max(waist_turn(m.frames[t], c.rotation[t], c.shift[t], p.follow[t]).drop_m, 0.0);
+  }
+  c.drop = p.drop_envelope.smooth(need);
+  for (std::size_t t = first; t < n; ++t) {
+    if (c.rotation[t].isZero(0.0) && c.shift[t].isZero(0.0) && c.drop[t] == 0.0) continue;
     double drop = 0.0;
     bool reachable = true;
-    c.frames[t] = correct_waist(m.frames[t], c.rotation[t], c.shift[t], &drop, &reachable, p.follow[t]);
+    c.frames[t] = correct_waist(m.frames[t], c.rotation[t], c.shift[t], &drop, &reachable, p.follow[t], c.drop[t]);
+    c.drop[t] = drop;
     for (std::size_t k = 0; k < p.models.size(); ++k)
       c.segments[k][t] = place_segments(p.base[p.models[k]].mass, c.frames[t].p);
     c.changed[t] = true;
@@ -408,7 +420,15 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
     r.lookahead_frames = std::max(r.lookahead_frames, members.back().op.band);
   }
 
-  Problem p{motion, o, members, r.before, models, {}, follow_weights(motion, contacts, o.swing_follow_ramp_s), {}};
+  Problem p{motion,
+            o,
+            members,
+            r.before,
+            models,
+            {},
+            follow_weights(motion, contacts, o.swing_follow_ramp_s),
+            {},
+            detail::DropEnvelope(motion.dt_s)};
   // The balance layer (lean, yaw, shift) and the fine layer (a few millimetres
   // of shift, fast enough to take the capture's jitter out of the centre of mass).
   std::vector<std::size_t> imbalanced;  // frames (from the first analysed) outside under some member
@@ -484,7 +504,8 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
           rot(static_cast<Eigen::Index>(e)) += h;
         else
           sh(static_cast<Eigen::Index>(e - 3)) += h;
-        const MotionFrame probe = correct_waist(motion.frames[t], rot, sh, nullptr, nullptr, p.follow[t]);
+        const MotionFrame probe =
+            correct_waist(motion.frames[t], rot, sh, nullptr, nullptr, p.follow[t], now.motion.drop[t]);
         for (std::size_t k = 0; k < models.size(); ++k) {
           const SegmentFrame moved = place_segments(r.before[models[k]].mass, probe.p);
           const SegmentFrame& at = now.motion.segments[k][t];
@@ -610,6 +631,7 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
 
   // The result, analysed afresh (smoothing included) under every member.
   r.follow = p.follow;
+  r.drop_m = now.motion.drop;
   r.rotation = now.motion.rotation;
   r.shift_m = now.motion.shift;
   r.corrected = motion;

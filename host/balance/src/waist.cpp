@@ -78,8 +78,8 @@ Vec3 WaistTurn::knee_side(const MotionFrame& in, std::size_t li, const Vec3& hip
   return v.normalized();
 }
 
-WaistTurn waist_turn(const MotionFrame& in, const Vec3& delta, const Vec2& shift_m,
-                     const std::array<double, 2>& follow) {
+WaistTurn waist_turn(const MotionFrame& in, const Vec3& delta, const Vec2& shift_m, const std::array<double, 2>& follow,
+                     double min_drop_m) {
   WaistTurn w;
   w.rotation = exp_map(delta);
   w.pivot = in.p[index(Landmark::MidHip)];
@@ -111,7 +111,7 @@ WaistTurn waist_turn(const MotionFrame& in, const Vec3& delta, const Vec2& shift
     w.reachable = false;
     w.drop_m = -0.5 * (lo + hi);  // as close to both as a single shift gets
   } else {
-    w.drop_m = -std::clamp(0.0, lo, hi);
+    w.drop_m = -std::clamp(-std::max(min_drop_m, 0.0), lo, hi);
   }
   return w;
 }
@@ -121,8 +121,8 @@ MotionFrame rotate_waist(const MotionFrame& in, const Vec3& delta, double* drop_
 }
 
 MotionFrame correct_waist(const MotionFrame& in, const Vec3& delta, const Vec2& shift_m, double* drop_m,
-                          bool* reachable, const std::array<double, 2>& follow) {
-  const WaistTurn w = waist_turn(in, delta, shift_m, follow);
+                          bool* reachable, const std::array<double, 2>& follow, double min_drop_m) {
+  const WaistTurn w = waist_turn(in, delta, shift_m, follow, min_drop_m);
   if (drop_m != nullptr) *drop_m = w.drop_m;
   if (reachable != nullptr) *reachable = w.reachable;
   MotionFrame out = in;

@@ -54,10 +54,13 @@ struct AppliedCorrection {
 // filter's, one rotation vector per frame (internal frame, radians),
 // `shift_m` the pelvis's horizontal shift per frame (internal frame, metres;
 // empty: none) and `follow` how much each swinging foot follows the pelvis
-// per frame (WaistTurn::follow; empty: the feet stay).
+// per frame (WaistTurn::follow; empty: the feet stay), and `drop_m` how far the
+// pelvis is lowered at least per frame (the filter's drop, smoothed over time;
+// empty: as far as each frame's legs need).
 AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeometry& geometry,
                                    const HumanMotion& motion, const std::vector<Vec3>& correction,
                                    const std::vector<Vec2>& shift_m = {},
-                                   const std::vector<std::array<double, 2>>& follow = {});
+                                   const std::vector<std::array<double, 2>>& follow = {},
+                                   const std::vector<double>& drop_m = {});
 
 }  // namespace tonus::balance

@@ -48,6 +48,7 @@ struct FilterResult {
   std::size_t frames_unsolved = 0;
   double max_foot_displacement_m = 0.0;  // of the feet's landmarks (zero up to rounding)
   double max_drop_m = 0.0;               // the largest vertical pelvis shift the legs needed
+  std::vector<double> drop_m;            // per frame: the pelvis lowered at least this much (empty: as needed)
   int iterations = 0;
   std::size_t operator_band = 0;  // frames on each side a frame's acceleration depends on (the look-ahead)
   std::string error;
@@ -89,9 +90,11 @@ struct WaistTurn {
   bool reachable = true;
 };
 // `shift_m` moves the pelvis and everything above it horizontally after the
-// turn (the robust filter's pelvis translation; zero for this filter).
+// turn (the robust filter's pelvis translation; zero for this filter). The
+// drop is the least the legs need, or `min_drop_m` where that is more and the
+// legs allow it (a drop smoothed over time: drop_envelope.hpp).
 WaistTurn waist_turn(const MotionFrame& frame, const Vec3& delta, const Vec2& shift_m = Vec2::Zero(),
-                     const std::array<double, 2>& follow = {});
+                     const std::array<double, 2>& follow = {}, double min_drop_m = 0.0);
 
 // The frame with that correction applied: pelvis and upper body moved
 // rigidly, both legs re-solved by two-bone IK to keep their feet.
@@ -104,6 +107,6 @@ double leg_reach_m(const Vec3& hip, const Vec3& knee, const Vec3& ankle);
 
 // The same with a horizontal pelvis shift after the turn.
 MotionFrame correct_waist(const MotionFrame& frame, const Vec3& delta, const Vec2& shift_m, double* drop_m = nullptr,
-                          bool* reachable = nullptr, const std::array<double, 2>& follow = {});
+                          bool* reachable = nullptr, const std::array<double, 2>& follow = {}, double min_drop_m = 0.0);
 
 }  // namespace tonus::balance

@@ -40,7 +40,8 @@
 
 namespace tonus::balance::detail {
 class ConstrainedPreview;
-}
+class DropEnvelope;
+}  // namespace tonus::balance::detail
 
 namespace tonus::balance {
 
@@ -92,7 +93,7 @@ struct OnlineFrame {
   Vec2 zmp_before = Vec2::Zero();  // the input's ZMP as the window saw it
   double outside_before_m = 0.0;   // its signed distance to the support polygon (> 0 outside); 0 when airborne
   double share = 0.0;              // of the shift, what the centre of mass follows
-  double drop_m = 0.0;             // the pelvis lowered for a straight leg to keep reaching its foot
+  double drop_m = 0.0;             // the pelvis lowered for a straight leg to keep reaching its foot, eased over time
   bool shift_capped = false;       // the shift wanted more than max_shift_m
   bool reachable = true;           // false: a leg could not reach its foot (the foot moved)
 };
@@ -137,7 +138,14 @@ class OnlineBalance {
   CausalContacts contacts_;
   std::vector<derivatives::FixedLag3> segments_;  // one per mass part
   PreviewModel preview_;
-  std::unique_ptr<detail::ConstrainedPreview> planner_;                                    // null: the plain preview
+  std::unique_ptr<detail::ConstrainedPreview> planner_;  // null: the plain preview
+  // The drop eased over time (drop_envelope.hpp): each frame's need, the
+  // emitted ones as applied (a ring over the envelope's reach), the ones
+  // ahead predicted under the shift of the frame going out.
+  std::unique_ptr<detail::DropEnvelope> drop_envelope_;
+  std::vector<double> past_need_;
+  std::vector<double> need_window_;
+  std::array<double, 2> drop_state_{};  // the drop applied last (m) and its rate (m/s)
   std::array<Eigen::Vector3d, 2> cart_{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};  // x, y offsets
   // Rings over the window (lag + 1 frames), frame k at k % (lag + 1).
   std::vector<MotionFrame> frames_;
@@ -169,7 +177,8 @@ struct OnlineBalance::Created {
 // at load and played.
 struct OnlineRun {
   HumanMotion corrected;
-  std::vector<Vec2> shift_m;  // per frame
+  std::vector<Vec2> shift_m;   // per frame
+  std::vector<double> drop_m;  // per frame: the pelvis lowered (apply_correction's drop_m)
   double max_drop_m = 0.0;
   std::size_t lookahead_frames = 0;
   double mean_push_us = 0.0, max_push_us = 0.0;  // the cost of push(), wall clock

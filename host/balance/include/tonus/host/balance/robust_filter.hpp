@@ -72,6 +72,7 @@ struct RobustFilterResult {
   std::vector<Vec3> rotation;                 // per frame: the waist's turn (rotation vector, world, rad)
   std::vector<Vec2> shift_m;                  // per frame: the pelvis's horizontal shift (world, m)
   std::vector<std::array<double, 2>> follow;  // per frame and leg: how much the foot followed (WaistTurn::follow)
+  std::vector<double> drop_m;  // per frame: the pelvis lowered (m), eased over time where a straight leg needs it
   std::vector<AnalysisOptions> members;
   std::vector<Analysis> before;  // per member, the original
   std::vector<Analysis> after;   // per member, the corrected motion analysed afresh
