@@ -188,6 +188,7 @@ Corrected correct(const Problem& p, const Eigen::VectorXd& q) {
     need[t] = std::max(waist_turn(m.frames[t], c.rotation[t], c.shift[t], p.follow[t]).drop_m, 0.0);
   }
   c.drop = p.drop_envelope.smooth(need);
+  std::fill(c.drop.begin(), c.drop.begin() + static_cast<std::ptrdiff_t>(std::min(first, n)), 0.0);  // a T-pose stays
   for (std::size_t t = first; t < n; ++t) {
     if (c.rotation[t].isZero(0.0) && c.shift[t].isZero(0.0) && c.drop[t] == 0.0) continue;
     double drop = 0.0;
