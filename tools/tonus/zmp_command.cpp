@@ -328,9 +328,8 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
       }
       fmt::print(
           "  correction: lean up to {:.1f} deg, yaw up to {:.1f} deg, pelvis shift up to {:.1f} cm, lowered up to "
-          "{:.1f} "
-          "mm; feet down moved by at most {:.2e} m, feet in the air followed the pelvis by up to {:.1f} cm; {} "
-          "iterations\n",
+          "{:.1f} mm; feet down moved by at most {:.2e} m, feet in the air followed the pelvis by up to {:.1f} cm; "
+          "{} iterations\n",
           lean * 180.0 / M_PI, yaw * 180.0 / M_PI, 100.0 * shift, 1000.0 * result.max_drop_m,
           applied.max_foot_displacement_m, 100.0 * applied.max_swing_foot_displacement_m, result.iterations);
     }

@@ -30,20 +30,22 @@ DropEnvelope::DropEnvelope(double dt_s, std::size_t max_reach_frames) {
   raise_ = peak > 0.0 ? 1.0 / peak : 1.0;
 }
 
+double DropEnvelope::spread(const double* need, std::ptrdiff_t count, std::ptrdiff_t j) const {
+  const auto ease = static_cast<std::ptrdiff_t>(ease_);
+  double envelope = 0.0;
+  for (std::ptrdiff_t s = std::max<std::ptrdiff_t>(j - ease, 0); s <= std::min(j + ease, count - 1); ++s) {
+    if (need[s] > 0.0) envelope = std::max(envelope, need[s] * cosine_[static_cast<std::size_t>(std::abs(s - j))]);
+  }
+  return envelope;
+}
+
 double DropEnvelope::at(const double* need, std::size_t count, std::size_t t) const {
   const auto n = static_cast<std::ptrdiff_t>(count);
-  const auto ease = static_cast<std::ptrdiff_t>(ease_);
   const auto blur = static_cast<std::ptrdiff_t>(blur_);
   const auto tt = static_cast<std::ptrdiff_t>(t);
   double sum = 0.0;
-  for (std::ptrdiff_t u = -blur; u <= blur; ++u) {
-    const std::ptrdiff_t j = tt + u;  // the envelope at j: the largest spread need
-    double envelope = 0.0;
-    for (std::ptrdiff_t s = std::max<std::ptrdiff_t>(j - ease, 0); s <= std::min(j + ease, n - 1); ++s) {
-      if (need[s] > 0.0) envelope = std::max(envelope, need[s] * cosine_[static_cast<std::size_t>(std::abs(s - j))]);
-    }
-    sum += gauss_[static_cast<std::size_t>(std::abs(u))] * envelope;
-  }
+  for (std::ptrdiff_t u = -blur; u <= blur; ++u)
+    sum += gauss_[static_cast<std::size_t>(std::abs(u))] * spread(need, n, tt + u);
   return raise_ * sum;
 }
 
@@ -52,17 +54,10 @@ std::vector<double> DropEnvelope::smooth(const std::vector<double>& need) const 
   // the Gaussian over it) rather than the envelope again for each of its
   // neighbours: the same sums in the same order.
   const auto n = static_cast<std::ptrdiff_t>(need.size());
-  const auto ease = static_cast<std::ptrdiff_t>(ease_);
   const auto blur = static_cast<std::ptrdiff_t>(blur_);
   std::vector<double> envelope(need.size() + 2 * blur_, 0.0);  // frames -blur .. n - 1 + blur
-  for (std::ptrdiff_t j = -blur; j < n + blur; ++j) {
-    double e = 0.0;
-    for (std::ptrdiff_t s = std::max<std::ptrdiff_t>(j - ease, 0); s <= std::min(j + ease, n - 1); ++s) {
-      if (need[static_cast<std::size_t>(s)] > 0.0)
-        e = std::max(e, need[static_cast<std::size_t>(s)] * cosine_[static_cast<std::size_t>(std::abs(s - j))]);
-    }
-    envelope[static_cast<std::size_t>(j + blur)] = e;
-  }
+  for (std::ptrdiff_t j = -blur; j < n + blur; ++j)
+    envelope[static_cast<std::size_t>(j + blur)] = spread(need.data(), n, j);
   std::vector<double> out(need.size(), 0.0);
   for (std::ptrdiff_t t = 0; t < n; ++t) {
     double sum = 0.0;

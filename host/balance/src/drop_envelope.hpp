@@ -39,6 +39,9 @@ class DropEnvelope {
   [[nodiscard]] std::vector<double> smooth(const std::vector<double>& need) const;
 
  private:
+  // The upper envelope at frame j of the needs spread by the raised cosine.
+  [[nodiscard]] double spread(const double* need, std::ptrdiff_t count, std::ptrdiff_t j) const;
+
   std::size_t ease_ = 0;  // the raised cosine's half width, frames
   std::size_t blur_ = 0;  // the Gaussian's half width (3 deviations), frames
   std::array<double, kMaxReach + 1> cosine_{};
