@@ -18,14 +18,20 @@ Loaded load(const std::string& path, const ConvertOptions& options) {
   return l;
 }
 
-std::vector<std::size_t> rotation_jumps(const motion::Clip& clip, double degrees) {
+std::vector<std::size_t> rotation_jumps(const motion::Clip& clip, double degrees, double lock_margin_deg) {
   const std::vector<std::size_t> start = motion::channel_columns(clip);
   std::vector<std::size_t> jumps(clip.channel_count(), 0);
   for (std::size_t j = 0; j < clip.joints.size(); ++j) {
-    for (std::size_t c = 0; c < clip.joints[j].channels.size(); ++c) {
-      if (!motion::is_rotation(clip.joints[j].channels[c])) continue;
-      const std::size_t column = start[j] + c;
+    std::vector<std::size_t> rotations;
+    for (std::size_t c = 0; c < clip.joints[j].channels.size(); ++c)
+      if (motion::is_rotation(clip.joints[j].channels[c])) rotations.push_back(start[j] + c);
+    const auto near_lock = [&](std::size_t f) {
+      if (rotations.size() != 3 || lock_margin_deg <= 0.0) return false;
+      return std::abs(std::abs(std::remainder(clip.frame(f)[rotations[1]], 360.0)) - 90.0) < lock_margin_deg;
+    };
+    for (const std::size_t column : rotations) {
       for (std::size_t f = 1; f < clip.frame_count; ++f) {
+        if (near_lock(f) || near_lock(f - 1)) continue;
         if (std::abs(clip.frame(f)[column] - clip.frame(f - 1)[column]) > degrees) ++jumps[column];
       }
     }

@@ -23,8 +23,11 @@ Loaded load(const std::string& path, const ConvertOptions& options = {});
 
 // Euler discontinuities: per column of a frame row, how many consecutive
 // frames differ by more than `degrees` (rotation channels; position columns
-// count zero).
-std::vector<std::size_t> rotation_jumps(const motion::Clip& clip, double degrees = 90.0);
+// count zero). With `lock_margin_deg`, a pair of frames either of which has
+// its joint's middle angle within that of +-90 degrees is not counted: a
+// rotation passing that close to gimbal lock turns the first and last angles
+// by up to 180 degrees within a few frames in any Euler representation.
+std::vector<std::size_t> rotation_jumps(const motion::Clip& clip, double degrees = 90.0, double lock_margin_deg = 0.0);
 // The motion with its leading T-pose (the frames before first_frame) cut off.
 HumanMotion without_leading_tpose(const HumanMotion& m);
 // "Joint Channel" for a column of a frame row, for messages.
