@@ -110,18 +110,19 @@ TEST_CASE("online balance filter, crosschecked: Bandai walk, fewer frames outsid
   CHECK(c.pelvis.max_accel_mps2 < 3.0);
 }
 
-TEST_CASE("online balance filter, crosschecked: Bandai kicks, fewer frames outside, within 3 cm RMS of offline" *
+TEST_CASE("online balance filter, crosschecked: Bandai kicks, fewer frames outside, within 3.2 cm RMS of offline" *
           tonus::test::heavy_under_sanitizers()) {
   // 131 -> 91 of 358; 2.85 cm RMS, 6.8 max (the window at 10 Hz, the
   // knee's side kept: the offline edit grew, 3.2 -> 3.4 cm RMS; 2.47 / 7.0
   // before it; at 6 Hz 91 and 2.47 / 6.4; the plain preview: 108 and
-  // 2.41 / 6.5).
+  // 2.41 / 6.5). The offline result's arms swinging too (2026-12-05): 3.08 /
+  // 7.3.
   const Crosschecked c =
       crosscheck("Bandai kicks", test::shared_clip("dataset-1_kick_normal_001.bvh"), indep::kCentimetre_m, 0);
   CHECK(c.independent_after < c.independent_before);
   CHECK(c.independent_after <= 95);
-  CHECK(c.online_to_offline.rms_m < 0.030);
-  CHECK(c.online_to_offline.max_m < 0.072);
+  CHECK(c.online_to_offline.rms_m < 0.032);
+  CHECK(c.online_to_offline.max_m < 0.076);
   // The pelvis's drop eased (drop_envelope.hpp, and a 3 Hz follower): p99 of its
   // vertical acceleration 3.1 m/s^2 (4.3 frame by frame); at most 6.5 (6.6), where
   // a need none of the frames before foresaw forces it.

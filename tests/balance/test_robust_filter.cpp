@@ -42,8 +42,8 @@ Checked run(const std::string& name, const std::string& path, double unit_m, std
   const test::Loaded l = test::load(path);
   const RobustFilterResult r = robust_balance_filter(l.conversion.motion, o);
   REQUIRE_MESSAGE(r.ok(), r.error);
-  const AppliedCorrection applied =
-      apply_correction(l.clip, l.conversion.geometry, l.conversion.motion, r.rotation, r.shift_m, r.follow, r.drop_m);
+  const AppliedCorrection applied = apply_correction(l.clip, l.conversion.geometry, l.conversion.motion, r.rotation,
+                                                     r.shift_m, r.follow, r.drop_m, r.arm_swing_rad);
   REQUIRE_MESSAGE(applied.ok(), applied.error);
   const motion::ReadResult back = motion::parse_bvh(motion::write_bvh(applied.clip, 6));
   REQUIRE(back.ok());
@@ -65,14 +65,19 @@ Checked run(const std::string& name, const std::string& path, double unit_m, std
   CHECK(r.max_lean_rad <= o.max_lean_rad + 1e-9);
   CHECK(r.max_yaw_rad <= o.max_yaw_rad + 1e-9);
   CHECK(r.max_shift_m <= o.max_shift_m + o.max_fine_shift_m + 1e-9);
-  // No new Euler discontinuities in the written file.
-  const std::vector<std::size_t> jumps_before = test::rotation_jumps(l.clip),
-                                 jumps_after = test::rotation_jumps(back.clip);
-  for (std::size_t k = 0; k < jumps_before.size(); ++k) CHECK(jumps_after[k] <= jumps_before[k]);
+  CHECK(r.max_arm_swing_rad <= o.max_arm_swing_rad + 1e-9);
+  // No new Euler discontinuities in the written file, away from gimbal lock:
+  // the kicks' hips pass within 1.5 degrees of it at frame 75 of one result
+  // (the capture within 5 degrees, its first and last angles turning 77
+  // degrees a frame there), where no representation avoids a swing.
+  const std::vector<std::size_t> jumps_before = test::rotation_jumps(l.clip, 90.0, 5.0),
+                                 jumps_after = test::rotation_jumps(back.clip, 90.0, 5.0);
+  for (std::size_t k = 0; k < jumps_before.size(); ++k)
+    CHECK_MESSAGE(jumps_after[k] <= jumps_before[k], name << ": " << test::column_name(back.clip, k));
 
   // Local: a frame inside by 2 cm under every member, more than 0.3 s from
   // any frame that is outside under some member, keeps its trunk's
-  // orientation within 1 degree.
+  // orientation, and its arms, within 1 degree.
   const std::size_t n = l.conversion.motion.size();
   std::vector<bool> needs(n, false), comfortable(n, true);
   for (const Analysis& a : r.before) {
@@ -98,8 +103,9 @@ Checked run(const std::string& name, const std::string& path, double unit_m, std
     }
     if (near) continue;
     ++far;
-    far_max = std::max(far_max, r.rotation[t].norm());
-    far_turned += r.rotation[t].norm() > kDegree ? 1U : 0U;
+    const double turned = std::max(r.rotation[t].norm(), r.arm_swing_rad[t].cwiseAbs().maxCoeff());
+    far_max = std::max(far_max, turned);
+    far_turned += turned > kDegree ? 1U : 0U;
   }
   CHECK_MESSAGE(far_turned == 0, name << ": " << far_turned << " of " << far
                                       << " far, comfortable frames turned by more "
@@ -127,8 +133,9 @@ Checked run(const std::string& name, const std::string& path, double unit_m, std
   MESSAGE(name << ": frames outside by more than 1 cm, before -> written, of " << c.written.members[0].supported << ": "
                << members << "; independent " << c.independent_before << " -> " << c.independent_after << " of "
                << c.independent_supported << "; lean " << r.max_lean_rad / kDegree << " deg, yaw "
-               << r.max_yaw_rad / kDegree << " deg, shift " << 100.0 * r.max_shift_m << " cm; far frames " << far
-               << ", largest turn there " << far_max / kDegree << " deg; " << r.iterations << " iterations");
+               << r.max_yaw_rad / kDegree << " deg, shift " << 100.0 * r.max_shift_m << " cm, arms "
+               << r.max_arm_swing_rad / kDegree << " deg; far frames " << far << ", largest turn there "
+               << far_max / kDegree << " deg; " << r.iterations << " iterations");
   MESSAGE(name << ": independent estimator after: " << c.timing.outside_near_change << " of its " << c.timing.outside
                << " frames outside within 0.1 s of one of its contact changes (" << c.timing.defined_near_change
                << " of its " << c.timing.defined << " supported frames are), concentration "
@@ -197,6 +204,33 @@ TEST_CASE("robust balance filter: CMU walk (bundled), most frames balanced under
   CHECK(c.pelvis.max_accel_mps2 < 2.0);
 }
 
+TEST_CASE("robust balance filter: Bandai Namco punches, cheap arm swings take the 6-12 Hz members in" *
+          tonus::test::heavy_under_sanitizers()) {
+  // The worst frames under 6-12 Hz, with the waist alone and with the arms
+  // swinging too, weighted low (0.01 per radian, a tenth of the default); the
+  // 4 Hz members stay the limit (the lunges' landings, docs/balance.md), so
+  // the clip is not balanced either way.
+  const auto worst_above_4hz = [](const FamilyVerdict& v) {
+    std::size_t w = 0;
+    for (const MemberVerdict& m : v.members) w = std::max(w, m.cutoff_hz > 5.0 ? m.outside : std::size_t{0});
+    return w;
+  };
+  RobustFilterOptions waist_only;
+  waist_only.max_arm_swing_rad = 0.0;
+  const std::string path = test::shared_clip("dataset-1_punch_normal_001.bvh");
+  const Checked without = run("Bandai punches, waist only", path, indep::kCentimetre_m, 0, waist_only);
+  RobustFilterOptions cheap_arms;
+  cheap_arms.arm_weight = 0.01;
+  const Checked with = run("Bandai punches, cheap arms", path, indep::kCentimetre_m, 0, cheap_arms);
+  MESSAGE("worst member above 4 Hz: " << worst_above_4hz(without.written) << " -> " << worst_above_4hz(with.written)
+                                      << "; worst member: " << without.written.members[without.written.worst].outside
+                                      << " -> " << with.written.members[with.written.worst].outside << " of "
+                                      << with.written.members[0].supported);
+  CHECK(worst_above_4hz(with.written) * 3 <= worst_above_4hz(without.written));
+  CHECK(with.written.members[with.written.worst].outside < without.written.members[without.written.worst].outside);
+  CHECK(with.independent_after < with.independent_before);
+}
+
 TEST_CASE("robust balance filter: Bandai Namco kicks, the kicking leg swings with the body" *
           tonus::test::heavy_under_sanitizers()) {
   const Checked c =
@@ -206,6 +240,7 @@ TEST_CASE("robust balance filter: Bandai Namco kicks, the kicking leg swings wit
   // With the swinging foot kept where the capture has it, the worst member found 84.
   CHECK(c.written.members[c.written.worst].outside <= 12);
   CHECK(c.written.members[c.written.worst].share() <= 0.035);
+  // 62 since the arms swing (2026-12-05; 70 before).
   CHECK(c.independent_after <= 72);
   // Measured: 42 of the 64 within 0.1 s of its contact changes (133 of 358
   // frames are), concentration 1.77; but 62 with landings called at up to

@@ -106,6 +106,18 @@ int run(int argc, char** argv) {
       ->add_option("--max-correction", zmp.max_correction_rad,
                    "--correction rotation: largest waist rotation per frame, rad")
       ->check(CLI::Range(0.01, 2.0));
+  zmp_cmd
+      ->add_option("--max-arm-swing", zmp.max_arm_swing_rad,
+                   "The robust filter's largest swing of each arm about its shoulder, rad (0: the arms stay as "
+                   "captured)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.5));
+  zmp_cmd
+      ->add_option("--arm-weight", zmp.arm_weight,
+                   "The robust filter's cost of a radian of arm swing, as metres of ZMP outside (lower: the arms "
+                   "swing more, on more frames)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.001, 10.0));
   zmp_cmd->add_option("--iterations", zmp.max_iterations, "Solver iterations at most")->check(CLI::Range(0, 10000));
   zmp_cmd->add_flag("--keep-tpose", zmp.keep_tpose, "Analyse a leading T-pose frame too");
   zmp_cmd->add_flag("-q,--quiet", zmp.quiet, "No report on stdout");

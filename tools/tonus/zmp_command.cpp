@@ -110,6 +110,8 @@ balance::FilterResult as_filter_result(balance::RobustFilterResult&& r, const ba
   f.shift_m = std::move(r.shift_m);
   f.follow = std::move(r.follow);
   f.drop_m = std::move(r.drop_m);
+  f.arm_swing_rad = std::move(r.arm_swing_rad);
+  f.max_arm_swing_rad = r.max_arm_swing_rad;
   f.unsolved = std::move(r.unsolved);
   f.frames_unsolved = r.frames_unsolved;
   f.max_foot_displacement_m = r.max_foot_displacement_m;
@@ -234,6 +236,8 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
     if (opt.margin_m >= 0.0) ro.margin_m = opt.margin_m;
     ro.max_iterations = opt.max_iterations;
     ro.both_trunks = opt.both_trunks;
+    ro.max_arm_swing_rad = opt.max_arm_swing_rad;
+    ro.arm_weight = opt.arm_weight;
     balance::RobustFilterResult robust = balance::robust_balance_filter(conv.motion, ro, on_progress, &progress);
     if (progress.show) fmt::print(stderr, "\n");
     if (!robust.ok()) return fail(robust.error);
@@ -245,8 +249,9 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
   }
   if (!result.ok()) return fail(result.error);
 
-  balance::AppliedCorrection applied = balance::apply_correction(
-      read.clip, conv.geometry, conv.motion, result.correction, shift_m, result.follow, result.drop_m);
+  balance::AppliedCorrection applied =
+      balance::apply_correction(read.clip, conv.geometry, conv.motion, result.correction, shift_m, result.follow,
+                                result.drop_m, result.arm_swing_rad);
   if (!applied.ok()) return fail(applied.error);
   if (!opt.output.empty()) {
     std::ofstream out(opt.output, std::ios::binary);
@@ -328,10 +333,11 @@ int run_zmp_command(const ZmpCommandOptions& opt) {
       }
       fmt::print(
           "  correction: lean up to {:.1f} deg, yaw up to {:.1f} deg, pelvis shift up to {:.1f} cm, lowered up to "
-          "{:.1f} mm; feet down moved by at most {:.2e} m, feet in the air followed the pelvis by up to {:.1f} cm; "
-          "{} iterations\n",
+          "{:.1f} mm, arms swung up to {:.1f} deg; feet down moved by at most {:.2e} m, feet in the air followed the "
+          "pelvis by up to {:.1f} cm; {} iterations\n",
           lean * 180.0 / M_PI, yaw * 180.0 / M_PI, 100.0 * shift, 1000.0 * result.max_drop_m,
-          applied.max_foot_displacement_m, 100.0 * applied.max_swing_foot_displacement_m, result.iterations);
+          result.max_arm_swing_rad * 180.0 / M_PI, applied.max_foot_displacement_m,
+          100.0 * applied.max_swing_foot_displacement_m, result.iterations);
     }
     // Only the joints and frames changed count, so the figure is the edit's real size.
     std::string largest;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "tonus/host/balance/online_filter.hpp"
+#include "tonus/host/balance/robust_filter.hpp"
 
 namespace tonus::tools {
 
@@ -41,6 +42,9 @@ struct ZmpCommandOptions {
   double window_cutoff_hz = balance::OnlineOptions{}.window_cutoff_hz;
   double margin_m = -1.0;  // negative: the correction's own (rotation 1 cm, waist 2 cm, online 1.5 cm)
   double max_correction_rad = 1.0;
+  // The robust filter's largest swing of each arm, rad (0: the arms are left as captured).
+  double max_arm_swing_rad = balance::RobustFilterOptions{}.max_arm_swing_rad;
+  double arm_weight = balance::RobustFilterOptions{}.arm_weight;  // its cost per radian
   int max_iterations = 100;
   bool keep_tpose = false;
   bool quiet = false;

@@ -127,6 +127,7 @@ bool write_zmp_json(const std::string& path, const ZmpReport& r, std::string& er
   const balance::AppliedCorrection& w = *r.applied;
   out += fmt::format("  \"max_foot_displacement_m\": {:.9f},\n", w.max_foot_displacement_m);
   out += fmt::format("  \"max_pelvis_drop_m\": {:.6f},\n", f.max_drop_m);
+  out += fmt::format("  \"max_arm_swing_rad\": {:.6f},\n", f.max_arm_swing_rad);
   // rms_joint_change_rad is the older all-mapped-joints figure, kept for existing readers.
   out += fmt::format("  \"rms_joint_change_rad\": {:.6f},\n", w.rms_change_all_mapped_joints_rad);
   out += fmt::format("  \"rms_change_changed_joints_rad\": {:.6f},\n", w.rms_change_changed_joints_rad);

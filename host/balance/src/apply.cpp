@@ -5,6 +5,7 @@
 #include <limits>
 #include <utility>
 
+#include "tonus/host/balance/arm_swing.hpp"
 #include "tonus/sim/math.hpp"
 
 namespace tonus::balance {
@@ -27,8 +28,8 @@ Quatd local_from(const std::vector<motion::JointPose>& poses, const std::vector<
 
 AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeometry& g, const HumanMotion& human,
                                    const std::vector<Vec3>& correction, const std::vector<Vec2>& shift_m,
-                                   const std::vector<std::array<double, 2>>& follow,
-                                   const std::vector<double>& drop_m) {
+                                   const std::vector<std::array<double, 2>>& follow, const std::vector<double>& drop_m,
+                                   const std::vector<Vec2>& arm_swing_rad) {
   const std::size_t first_frame = human.first_frame;
   AppliedCorrection out;
   out.clip = clip;
@@ -44,7 +45,8 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
   if (correction.size() != clip.frame_count || human.size() != clip.frame_count ||
       (!shift_m.empty() && shift_m.size() != clip.frame_count) ||
       (!follow.empty() && follow.size() != clip.frame_count) ||
-      (!drop_m.empty() && drop_m.size() != clip.frame_count)) {
+      (!drop_m.empty() && drop_m.size() != clip.frame_count) ||
+      (!arm_swing_rad.empty() && arm_swing_rad.size() != clip.frame_count)) {
     out.error = "one correction per frame is needed";
     return out;
   }
@@ -67,7 +69,10 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
     }
     const Vec2 shift = shift_m.empty() ? Vec2::Zero() : shift_m[f];
     const double least_drop = drop_m.empty() ? 0.0 : drop_m[f];
-    if (f < first_frame || (correction[f].norm() == 0.0 && shift.norm() == 0.0 && least_drop == 0.0)) continue;
+    const Vec2 swing = arm_swing_rad.empty() ? Vec2::Zero() : arm_swing_rad[f];
+    if (f < first_frame ||
+        (correction[f].norm() == 0.0 && shift.norm() == 0.0 && least_drop == 0.0 && swing.norm() == 0.0))
+      continue;
     // The same turn, shift and drop the filter used, in the file's frame and units.
     const WaistTurn turn = waist_turn(human.frames[f], correction[f], shift,
                                       follow.empty() ? std::array<double, 2>{} : follow[f], least_drop);
@@ -123,6 +128,20 @@ AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeome
       wanted.push_back(sim::quat_from_two_vectors(ankle - knee, ankle2 - knee2) * poses[su].rotation);
       desired[fu] = static_cast<int>(wanted.size());
       wanted.push_back(foot_turn * poses[fu].rotation);  // a planted foot keeps its world orientation
+    }
+    // Each arm's swing turns its upper arm about its shoulder joint, in the
+    // world after the waist's turn (arm_swing.hpp). The chain from the hips to
+    // the shoulder turned rigidly by r, so the upper arm's new world rotation is
+    // the swing's times r times its old one; the forearm and hand keep their
+    // local rotations and follow.
+    const Vec3 left_shoulder = turn.rotation * human.frames[f].p[sim::index(Bone::LeftUpperArm)],
+               right_shoulder = turn.rotation * human.frames[f].p[sim::index(Bone::RightUpperArm)];
+    for (std::size_t side = 0; side < 2; ++side) {
+      const Quatd swing_turn = arm_swing_turn(left_shoulder, right_shoulder, swing(static_cast<Eigen::Index>(side)));
+      if (swing_turn.vec().isZero(0.0)) continue;
+      const auto upper = static_cast<std::size_t>(bone(side == 0 ? Bone::LeftUpperArm : Bone::RightUpperArm));
+      desired[upper] = static_cast<int>(wanted.size());
+      wanted.push_back(to_int.conjugate() * swing_turn * to_int * r * poses[upper].rotation);
     }
     std::vector<bool> below(poses.size(), false);
     below[hu] = true;

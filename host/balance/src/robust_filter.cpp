@@ -9,6 +9,7 @@
 
 #include "accel_operator.hpp"
 #include "drop_envelope.hpp"
+#include "tonus/host/balance/arm_swing.hpp"
 #include "tonus/host/balance/zmp.hpp"
 #include "zmp_partials.hpp"
 
@@ -17,8 +18,10 @@ namespace {
 
 using detail::AccelOperator;
 
-// Per knot: the rotation vector (roll, pitch, yaw in the world) and the shift (x, y).
-constexpr std::size_t kDof = 5;
+// Per knot: the rotation vector (roll, pitch, yaw in the world), the shift
+// (x, y) and each arm's swing (left, right).
+constexpr std::size_t kDof = 7;
+constexpr std::size_t kShift = 3, kArms = 5;  // the first component of each
 
 // A uniform cubic B-spline over the analysed frames: frame kk (counted from
 // the first analysed frame) is a blend of knots i0 .. i0 + 3.
@@ -40,7 +43,7 @@ struct Spline {
 // One layer of the correction: a spline over some of the five components.
 struct Layer {
   Spline spline;
-  std::vector<std::size_t> dofs;  // which components (0-2 rotation, 3-4 shift)
+  std::vector<std::size_t> dofs;  // which components (0-2 rotation, 3-4 shift, 5-6 arms)
   Eigen::Index offset = 0;        // its first unknown
   std::array<double, kDof> weight{};
   double smoothness = 0.0;
@@ -81,6 +84,7 @@ std::vector<std::array<Vec3, kSegmentParts>> apply_operator(const AccelOperator&
 struct Corrected {
   std::vector<Vec3> rotation;
   std::vector<Vec2> shift;
+  std::vector<Vec2> arms;  // each arm's swing
   std::vector<MotionFrame> frames;
   std::vector<std::vector<SegmentFrame>> segments;  // [mass model][frame]
   std::vector<bool> changed;
@@ -172,6 +176,7 @@ Corrected correct(const Problem& p, const Eigen::VectorXd& q) {
   Corrected c;
   c.rotation.assign(n, Vec3::Zero());
   c.shift.assign(n, Vec2::Zero());
+  c.arms.assign(n, Vec2::Zero());
   c.frames = m.frames;
   c.segments.resize(p.models.size());
   for (std::size_t k = 0; k < p.models.size(); ++k) c.segments[k] = p.base[p.models[k]].segments;
@@ -184,16 +189,18 @@ Corrected correct(const Problem& p, const Eigen::VectorXd& q) {
     const Eigen::Matrix<double, kDof, 1> v = frame_value(p, q, t - first);
     if (v.isZero(0.0)) continue;
     c.rotation[t] = v.head<3>();
-    c.shift[t] = v.tail<2>();
+    c.shift[t] = v.segment<2>(kShift);
+    c.arms[t] = v.segment<2>(kArms);
     need[t] = std::max(waist_turn(m.frames[t], c.rotation[t], c.shift[t], p.follow[t]).drop_m, 0.0);
   }
   c.drop = p.drop_envelope.smooth(need);
   std::fill(c.drop.begin(), c.drop.begin() + static_cast<std::ptrdiff_t>(std::min(first, n)), 0.0);  // a T-pose stays
   for (std::size_t t = first; t < n; ++t) {
-    if (c.rotation[t].isZero(0.0) && c.shift[t].isZero(0.0) && c.drop[t] == 0.0) continue;
+    if (c.rotation[t].isZero(0.0) && c.shift[t].isZero(0.0) && c.arms[t].isZero(0.0) && c.drop[t] == 0.0) continue;
     double drop = 0.0;
     bool reachable = true;
-    c.frames[t] = correct_waist(m.frames[t], c.rotation[t], c.shift[t], &drop, &reachable, p.follow[t], c.drop[t]);
+    c.frames[t] = swing_arms(
+        correct_waist(m.frames[t], c.rotation[t], c.shift[t], &drop, &reachable, p.follow[t], c.drop[t]), c.arms[t]);
     c.drop[t] = drop;
     for (std::size_t k = 0; k < p.models.size(); ++k)
       c.segments[k][t] = place_segments(p.base[p.models[k]].mass, c.frames[t].p);
@@ -357,11 +364,15 @@ void clamp_knots(const RobustFilterOptions& o, const std::vector<Layer>& layers,
         v.setZero();
         continue;
       }
-      const Eigen::Index s0 = fine ? 0 : 3;
+      const Eigen::Index s0 = fine ? 0 : static_cast<Eigen::Index>(kShift);
       if (!fine) {
         const double lean = v.head<2>().norm();
         if (lean > o.max_lean_rad) v.head<2>() *= o.max_lean_rad / lean;
         v(2) = std::clamp(v(2), -o.max_yaw_rad, o.max_yaw_rad);
+        for (std::size_t d = kArms; d < l.dofs.size(); ++d) {  // the arms, when they are unknowns
+          const auto c = static_cast<Eigen::Index>(d);
+          v(c) = std::clamp(v(c), -o.max_arm_swing_rad, o.max_arm_swing_rad);
+        }
       }
       const double cap = fine ? o.max_fine_shift_m : o.max_shift_m;
       const double sn = v.segment<2>(s0).norm();
@@ -379,12 +390,13 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
   const auto finite_not_negative = [](double v) { return std::isfinite(v) && v >= 0.0; };
   if (!(std::isfinite(o.knot_spacing_s) && o.knot_spacing_s > 0.0) || !finite_not_negative(o.margin_m) ||
       !finite_not_negative(o.max_lean_rad) || !finite_not_negative(o.max_yaw_rad) ||
-      !finite_not_negative(o.max_shift_m) || !finite_not_negative(o.lean_weight) ||
-      !finite_not_negative(o.yaw_weight) || !finite_not_negative(o.shift_weight) ||
-      !finite_not_negative(o.smoothness) || !finite_not_negative(o.fine_knot_spacing_s) ||
-      !finite_not_negative(o.max_fine_shift_m) || !finite_not_negative(o.fine_shift_weight) ||
-      !finite_not_negative(o.swing_follow_ramp_s) || !(std::isfinite(o.far_weight) && o.far_weight >= 1.0) ||
-      !finite_not_negative(o.local_reach_s) || o.max_iterations < 0) {
+      !finite_not_negative(o.max_shift_m) || !finite_not_negative(o.max_arm_swing_rad) ||
+      !finite_not_negative(o.arm_weight) || !finite_not_negative(o.lean_weight) || !finite_not_negative(o.yaw_weight) ||
+      !finite_not_negative(o.shift_weight) || !finite_not_negative(o.smoothness) ||
+      !finite_not_negative(o.fine_knot_spacing_s) || !finite_not_negative(o.max_fine_shift_m) ||
+      !finite_not_negative(o.fine_shift_weight) || !finite_not_negative(o.swing_follow_ramp_s) ||
+      !(std::isfinite(o.far_weight) && o.far_weight >= 1.0) || !finite_not_negative(o.local_reach_s) ||
+      o.max_iterations < 0) {
     r.error =
         "robust filter: the knot spacing must be positive, and the margin, limits and weights finite and not "
         "negative";
@@ -448,10 +460,18 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
     Layer l;
     l.spline.frames_per_knot = std::max(1.0, (fine ? o.fine_knot_spacing_s : o.knot_spacing_s) / motion.dt_s);
     l.spline.knots = static_cast<std::size_t>(std::floor(static_cast<double>(m - 1) / l.spline.frames_per_knot)) + 4;
-    l.dofs = fine ? std::vector<std::size_t>{3, 4} : std::vector<std::size_t>{0, 1, 2, 3, 4};
+    // A zero cap leaves the arms out of the unknowns altogether.
+    l.dofs =
+        fine ? std::vector<std::size_t>{kShift, kShift + 1} : std::vector<std::size_t>{0, 1, 2, kShift, kShift + 1};
+    if (!fine && o.max_arm_swing_rad > 0.0) l.dofs.insert(l.dofs.end(), {kArms, kArms + 1});
     l.offset = unknowns;
-    l.weight = {o.lean_weight, o.lean_weight, o.yaw_weight, fine ? o.fine_shift_weight : o.shift_weight,
-                fine ? o.fine_shift_weight : o.shift_weight};
+    l.weight = {o.lean_weight,
+                o.lean_weight,
+                o.yaw_weight,
+                fine ? o.fine_shift_weight : o.shift_weight,
+                fine ? o.fine_shift_weight : o.shift_weight,
+                o.arm_weight,
+                o.arm_weight};
     l.smoothness = fine ? 0.0 : o.smoothness;
     l.pinned.assign(l.spline.knots, true);
     for (std::size_t kk = 0; kk < m; ++kk) {
@@ -477,6 +497,8 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
   }
   p.regulariser = regulariser_matrix(p.layers, unknowns);
   Eigen::VectorXd q = Eigen::VectorXd::Zero(unknowns);
+  // The components probed: the balance layer's (the first), which lists them in order.
+  const std::size_t dofs = p.layers.front().dofs.size();
   Evaluation now = evaluate(p, q);
   double damping = 1e-4;
   const double h = 1e-6;
@@ -498,15 +520,17 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
     for (std::size_t t = first; t < n; ++t) {
       if (!needed[t]) continue;
       any = true;
-      for (std::size_t e = 0; e < kDof; ++e) {
+      for (std::size_t e = 0; e < dofs; ++e) {
         Vec3 rot = now.motion.rotation[t];
-        Vec2 sh = now.motion.shift[t];
-        if (e < 3)
+        Vec2 sh = now.motion.shift[t], arms = now.motion.arms[t];
+        if (e < kShift)
           rot(static_cast<Eigen::Index>(e)) += h;
+        else if (e < kArms)
+          sh(static_cast<Eigen::Index>(e - kShift)) += h;
         else
-          sh(static_cast<Eigen::Index>(e - 3)) += h;
-        const MotionFrame probe =
-            correct_waist(motion.frames[t], rot, sh, nullptr, nullptr, p.follow[t], now.motion.drop[t]);
+          arms(static_cast<Eigen::Index>(e - kArms)) += h;
+        const MotionFrame probe = swing_arms(
+            correct_waist(motion.frames[t], rot, sh, nullptr, nullptr, p.follow[t], now.motion.drop[t]), arms);
         for (std::size_t k = 0; k < models.size(); ++k) {
           const SegmentFrame moved = place_segments(r.before[models[k]].mass, probe.p);
           const SegmentFrame& at = now.motion.segments[k][t];
@@ -559,7 +583,7 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
           const double w = op.at(kk, jj);
           if (w == 0.0 && jj != kk) continue;
           std::array<double, kDof> g{};
-          for (std::size_t e = 0; e < kDof; ++e) {
+          for (std::size_t e = 0; e < dofs; ++e) {
             for (std::size_t i = 0; i < kSegmentParts; ++i) {
               const Vec3& dc = dcom[model][first + jj][e][i];
               g[e] += w * along_acc[i].dot(dc);
@@ -635,6 +659,7 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
   r.drop_m = now.motion.drop;
   r.rotation = now.motion.rotation;
   r.shift_m = now.motion.shift;
+  r.arm_swing_rad = now.motion.arms;
   r.corrected = motion;
   r.corrected.frames = now.motion.frames;
   r.max_drop_m = now.motion.max_drop_m;
@@ -657,6 +682,7 @@ RobustFilterResult robust_balance_filter(const HumanMotion& motion, const Robust
     r.max_lean_rad = std::max(r.max_lean_rad, r.rotation[t].head<2>().norm());
     r.max_yaw_rad = std::max(r.max_yaw_rad, std::abs(r.rotation[t].z()));
     r.max_shift_m = std::max(r.max_shift_m, r.shift_m[t].norm());
+    r.max_arm_swing_rad = std::max(r.max_arm_swing_rad, r.arm_swing_rad[t].cwiseAbs().maxCoeff());
     for (const Foot foot : {Foot::left, Foot::right}) {
       const FootLandmarks fl = foot_landmarks(foot);
       double& largest =

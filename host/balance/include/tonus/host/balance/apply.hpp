@@ -56,11 +56,12 @@ struct AppliedCorrection {
 // empty: none) and `follow` how much each swinging foot follows the pelvis
 // per frame (WaistTurn::follow; empty: the feet stay), and `drop_m` how far the
 // pelvis is lowered at least per frame (the filter's drop, smoothed over time;
-// empty: as far as each frame's legs need).
+// empty: as far as each frame's legs need), and `arm_swing_rad` each arm's swing
+// per frame (left, right; arm_swing.hpp; empty: the arms keep their rotations).
 AppliedCorrection apply_correction(const motion::Clip& clip, const SkeletonGeometry& geometry,
                                    const HumanMotion& motion, const std::vector<Vec3>& correction,
                                    const std::vector<Vec2>& shift_m = {},
                                    const std::vector<std::array<double, 2>>& follow = {},
-                                   const std::vector<double>& drop_m = {});
+                                   const std::vector<double>& drop_m = {}, const std::vector<Vec2>& arm_swing_rad = {});
 
 }  // namespace tonus::balance

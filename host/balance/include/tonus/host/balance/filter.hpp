@@ -49,6 +49,8 @@ struct FilterResult {
   double max_foot_displacement_m = 0.0;  // of the feet's landmarks (zero up to rounding)
   double max_drop_m = 0.0;               // the largest vertical pelvis shift the legs needed
   std::vector<double> drop_m;            // per frame: the pelvis lowered at least this much (empty: as needed)
+  std::vector<Vec2> arm_swing_rad;       // per frame: each arm's swing (arm_swing.hpp; empty: none)
+  double max_arm_swing_rad = 0.0;
   int iterations = 0;
   std::size_t operator_band = 0;  // frames on each side a frame's acceleration depends on (the look-ahead)
   std::string error;

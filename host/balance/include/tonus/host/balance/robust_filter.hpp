@@ -5,7 +5,8 @@
 // - the correction is a lean (roll and pitch about the midpoint of the hip
 //   joints), a yaw and a horizontal shift of the pelvis and everything above
 //   it, the legs re-solved to keep the feet where the capture has them
-//   (filter.hpp's waist turn, plus the shift);
+//   (filter.hpp's waist turn, plus the shift), and a swing of each arm about
+//   its shoulder (arm_swing.hpp);
 // - it is a uniform cubic B-spline over time (knots `knot_spacing_s` apart), so
 //   it is smooth by construction, and a knot no violation depends on stays at
 //   exactly zero: frames far from any imbalance keep their pose;
@@ -40,11 +41,20 @@ struct RobustFilterOptions {
   double max_lean_rad = 0.2618;  // 15 degrees
   double max_yaw_rad = 0.1745;   // 10 degrees
   double max_shift_m = 0.08;
+  // Each arm's swing (arm_swing.hpp); 0: the arms are not used.
+  double max_arm_swing_rad = 0.5;
   // Costs, as the ZMP shift (m) a unit of each is worth: a correction that
   // moves the ZMP by x metres is paid about (weight x)^2 against x^2 of violation.
   double lean_weight = 0.06;
   double yaw_weight = 0.3;
   double shift_weight = 0.06;
+  // A swing's cost per radian. An arm is 5 % of the mass, so a swing moves
+  // the centre of mass far less than a lean of the same angle; its
+  // acceleration moves the ZMP more. At 0.01 the arms take in most of the
+  // punches' frames under the 6-12 Hz members, but they swing on most frames
+  // of every clip, by up to the cap; at 0.1 (measured, docs/balance.md) they
+  // move where a frame needs them, by up to 15 degrees.
+  double arm_weight = 0.1;
   double smoothness = 1.0;  // the balance knots' second difference, relative to their size
   // The fine layer: a pelvis shift of a few millimetres on knots 25 ms apart,
   // which takes the capture's jitter out of the centre of mass (estimators
@@ -71,6 +81,7 @@ struct RobustFilterResult {
   HumanMotion corrected;
   std::vector<Vec3> rotation;                 // per frame: the waist's turn (rotation vector, world, rad)
   std::vector<Vec2> shift_m;                  // per frame: the pelvis's horizontal shift (world, m)
+  std::vector<Vec2> arm_swing_rad;            // per frame: each arm's swing (left, right; forward positive)
   std::vector<std::array<double, 2>> follow;  // per frame and leg: how much the foot followed (WaistTurn::follow)
   std::vector<double> drop_m;  // per frame: the pelvis lowered (m), eased over time where a straight leg needs it
   std::vector<AnalysisOptions> members;
@@ -84,6 +95,7 @@ struct RobustFilterResult {
   double max_lean_rad = 0.0;
   double max_yaw_rad = 0.0;
   double max_shift_m = 0.0;
+  double max_arm_swing_rad = 0.0;
   double max_drop_m = 0.0;
   double max_foot_displacement_m = 0.0;        // of the feet down (zero up to rounding)
   double max_swing_foot_displacement_m = 0.0;  // of the feet in the air, which follow the pelvis
