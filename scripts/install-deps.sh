@@ -21,6 +21,8 @@ packages=(
   libwebsocketpp-dev libasio-dev chromium
   # tools used by tests and benchmarks
   can-utils valgrind python3
+  # a BVH reader that is not ours (tests/balance/test_blender_import.cpp)
+  blender
   # emulator for the firmware self-test (STM32F405 = machine netduinoplus2)
   qemu-system-arm
 )
