@@ -126,7 +126,7 @@ TEST_CASE("Blender's BVH importer puts every joint of every shared clip where ou
   for (const std::string& path : paths) {
     CAPTURE(path);
     const motion::ReadResult ours = motion::read_bvh_file(path);
-    REQUIRE_MESSAGE(ours.ok(), ours.error);
+    REQUIRE_MESSAGE(ours.ok(), (ours.error ? ours.error->message : std::string()));
     const BlenderImport b = import_in_blender(path, "original" + std::to_string(n++));
     REQUIRE_MESSAGE(b.error.empty(), b.error);
     CHECK(b.frames == ours.clip.frame_count);
@@ -157,7 +157,7 @@ void check_written(const std::string& name, const std::string& path) {
     REQUIRE(out.good());
   }
   const motion::ReadResult back = motion::read_bvh_file(written);
-  REQUIRE_MESSAGE(back.ok(), back.error);
+  REQUIRE_MESSAGE(back.ok(), (back.error ? back.error->message : std::string()));
   const BlenderImport before = import_in_blender(path, name + "-original");
   const BlenderImport after = import_in_blender(written, name + "-written");
   REQUIRE_MESSAGE(before.error.empty(), before.error);
