@@ -201,7 +201,8 @@ void check_written(const std::string& name, const std::string& path) {
   CHECK(hips_moved_m > 0.01);
 }
 
-TEST_CASE("the robust balance filter's written CMU walk imports in Blender, the feet down where they were") {
+TEST_CASE("the robust balance filter's written CMU walk imports in Blender, the feet down where they were" *
+          tonus::test::heavy_under_sanitizers()) {
   check_written("cmu-walk", test::bundled_clip("cmu_02_walk.bvh"));
 }
 
