@@ -97,9 +97,12 @@ const live = [
     const before = await lib.gaugeValues(page);
     lib.check(before.length > 0, 'no stiffness gauges (.gauge) on the page');
     lib.check(before.every((g) => g.value !== ''), `a gauge has no value: ${JSON.stringify(before)}`);
+    // tonusd --demo's band swells once over the demo (--seconds 120 here): its
+    // co-contraction crosses the stiffness's dead zone about 6.5 s after start,
+    // which a page that loads in half a second has to wait for.
     await lib.waitFor(page, 'a gauge to change',
       (initial) => [...document.querySelectorAll('.gauge')].some((g, i) => g.dataset.value !== initial[i]),
-      { timeoutMs: 4000, args: [before.map((g) => g.value)] });
+      { timeoutMs: 15000, args: [before.map((g) => g.value)] });
     const after = await lib.gaugeValues(page);
     console.log(`     ${before.map((g, i) => `${g.group} ${g.value} -> ${after[i].value}`).join(', ')}`);
   }],
