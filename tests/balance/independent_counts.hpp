@@ -114,4 +114,49 @@ inline PelvisHeightChange pelvis_height_change(const motion::Clip& original, con
   return c;
 }
 
+// Whether a correction adds jitter: the horizontal jerk (third difference
+// over dt^3) of the pelvis (the hip joints' midpoint) and of the neck, in the
+// original and in the written file, by the independent estimator's own
+// skeleton and forward kinematics, unsmoothed: RMS and 99th percentile.
+struct HorizontalJerk {
+  double rms_before_mps3 = 0.0, rms_after_mps3 = 0.0;
+  double p99_before_mps3 = 0.0, p99_after_mps3 = 0.0;
+};
+struct SiteJerks {
+  HorizontalJerk pelvis, neck;
+};
+
+inline SiteJerks horizontal_jerks(const motion::Clip& original, const motion::Clip& written, double unit_m,
+                                  std::size_t first_frame) {
+  const indep::SkeletonMap map = indep::map_skeleton(original);
+  REQUIRE_MESSAGE(map.ok(), map.error);
+  const std::vector<indep::Sites> a = indep::site_positions(original, map, unit_m, first_frame),
+                                  b = indep::site_positions(written, map, unit_m, first_frame);
+  REQUIRE(a.size() == b.size());
+  const double dt3 = std::pow(original.frame_time_s, 3);
+  const auto jerk = [&](const std::vector<indep::Sites>& s, auto&& point, double& rms, double& p99) {
+    std::vector<double> j;
+    for (std::size_t t = 3; t < s.size(); ++t) {
+      const Eigen::Vector3d d = point(s[t]) - 3.0 * point(s[t - 1]) + 3.0 * point(s[t - 2]) - point(s[t - 3]);
+      j.push_back(d.head<2>().norm() / dt3);
+    }
+    if (j.empty()) return;
+    double sum = 0.0;
+    for (const double v : j) sum += v * v;
+    rms = std::sqrt(sum / static_cast<double>(j.size()));
+    std::sort(j.begin(), j.end());
+    p99 = j[static_cast<std::size_t>(0.99 * static_cast<double>(j.size() - 1))];
+  };
+  const auto pelvis = [](const indep::Sites& s) -> Eigen::Vector3d {
+    return 0.5 * (s[indep::left_hip] + s[indep::right_hip]);
+  };
+  const auto neck = [](const indep::Sites& s) -> Eigen::Vector3d { return s[indep::neck]; };
+  SiteJerks j;
+  jerk(a, pelvis, j.pelvis.rms_before_mps3, j.pelvis.p99_before_mps3);
+  jerk(b, pelvis, j.pelvis.rms_after_mps3, j.pelvis.p99_after_mps3);
+  jerk(a, neck, j.neck.rms_before_mps3, j.neck.p99_before_mps3);
+  jerk(b, neck, j.neck.rms_after_mps3, j.neck.p99_after_mps3);
+  return j;
+}
+
 }  // namespace tonus::balance::test
