@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 #include "independent/skeleton.hpp"
@@ -79,6 +80,21 @@ inline ContactTiming contact_timing(const motion::Clip& written, double unit_m, 
   return c;
 }
 
+// The original's and the written clip's sites from `first_frame` on, by the
+// independent estimator's skeleton (mapped on the original) and kinematics.
+inline std::pair<std::vector<indep::Sites>, std::vector<indep::Sites>> site_pair(const motion::Clip& original,
+                                                                                 const motion::Clip& written,
+                                                                                 double unit_m,
+                                                                                 std::size_t first_frame) {
+  const indep::SkeletonMap map = indep::map_skeleton(original);
+  REQUIRE_MESSAGE(map.ok(), map.error);
+  std::pair<std::vector<indep::Sites>, std::vector<indep::Sites>> sites{
+      indep::site_positions(original, map, unit_m, first_frame),
+      indep::site_positions(written, map, unit_m, first_frame)};
+  REQUIRE(sites.first.size() == sites.second.size());
+  return sites;
+}
+
 // How smoothly a correction moves the pelvis up and down, read from the
 // written file by the independent estimator's own skeleton and forward
 // kinematics: the midpoint of the hip joints (the filters' pivot, which lean
@@ -92,11 +108,7 @@ struct PelvisHeightChange {
 
 inline PelvisHeightChange pelvis_height_change(const motion::Clip& original, const motion::Clip& written, double unit_m,
                                                std::size_t first_frame) {
-  const indep::SkeletonMap map = indep::map_skeleton(original);
-  REQUIRE_MESSAGE(map.ok(), map.error);
-  const std::vector<indep::Sites> a = indep::site_positions(original, map, unit_m, first_frame),
-                                  b = indep::site_positions(written, map, unit_m, first_frame);
-  REQUIRE(a.size() == b.size());
+  const auto [a, b] = site_pair(original, written, unit_m, first_frame);
   std::vector<double> dz(a.size());
   PelvisHeightChange c;
   for (std::size_t t = 0; t < a.size(); ++t) {
@@ -128,11 +140,7 @@ struct SiteJerks {
 
 inline SiteJerks horizontal_jerks(const motion::Clip& original, const motion::Clip& written, double unit_m,
                                   std::size_t first_frame) {
-  const indep::SkeletonMap map = indep::map_skeleton(original);
-  REQUIRE_MESSAGE(map.ok(), map.error);
-  const std::vector<indep::Sites> a = indep::site_positions(original, map, unit_m, first_frame),
-                                  b = indep::site_positions(written, map, unit_m, first_frame);
-  REQUIRE(a.size() == b.size());
+  const auto [a, b] = site_pair(original, written, unit_m, first_frame);
   const double dt3 = std::pow(original.frame_time_s, 3);
   const auto jerk = [&](const std::vector<indep::Sites>& s, auto&& point, double& rms, double& p99) {
     std::vector<double> j;

@@ -18,16 +18,31 @@
 namespace tonus::balance {
 namespace {
 
-double point_agreement(const std::string& path, double unit_m) {
-  const test::Loaded l = test::load(path);
-  const HumanMotion& m = l.conversion.motion;
-  const ContactTrack tool = detect_contacts(m, ContactOptions{});
+// A clip's contacts by both detectors.
+struct BothDetectors {
+  test::Loaded loaded;
+  ContactTrack tool;
+  indep::Estimate independent;
+};
+
+BothDetectors detect_both(const std::string& path, double unit_m) {
+  BothDetectors b{test::load(path), {}, {}};
+  const HumanMotion& m = b.loaded.conversion.motion;
+  b.tool = detect_contacts(m, ContactOptions{});
   indep::Options io;
   io.metres_per_unit = unit_m;
   io.first_frame = m.first_frame;
-  const indep::Estimate e = indep::estimate_zmp(l.clip, io);
-  REQUIRE(e.ok());
-  REQUIRE(e.frames.size() == m.size());
+  b.independent = indep::estimate_zmp(b.loaded.clip, io);
+  REQUIRE(b.independent.ok());
+  REQUIRE(b.independent.frames.size() == m.size());
+  return b;
+}
+
+double point_agreement(const std::string& path, double unit_m) {
+  const BothDetectors both = detect_both(path, unit_m);
+  const HumanMotion& m = both.loaded.conversion.motion;
+  const ContactTrack& tool = both.tool;
+  const indep::Estimate& e = both.independent;
   std::size_t agree = 0, total = 0;
   for (std::size_t t = m.first_frame; t < m.size(); ++t) {
     for (std::size_t f = 0; f < 2; ++f) {
@@ -56,14 +71,11 @@ struct LandingLags {
 };
 
 LandingLags landing_lags(const std::string& path, double unit_m) {
-  const test::Loaded l = test::load(path);
+  const BothDetectors both = detect_both(path, unit_m);
+  const test::Loaded& l = both.loaded;
   const HumanMotion& m = l.conversion.motion;
-  const ContactTrack tool = detect_contacts(m, ContactOptions{});
-  indep::Options io;
-  io.metres_per_unit = unit_m;
-  io.first_frame = m.first_frame;
-  const indep::Estimate e = indep::estimate_zmp(l.clip, io);
-  REQUIRE(e.ok());
+  const ContactTrack& tool = both.tool;
+  const indep::Estimate& e = both.independent;
   const indep::SkeletonMap map = indep::map_skeleton(l.clip);
   REQUIRE_MESSAGE(map.ok(), map.error);
   const std::vector<indep::Sites> sites = indep::site_positions(l.clip, map, unit_m, m.first_frame);
