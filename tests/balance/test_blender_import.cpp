@@ -14,6 +14,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "balance_fixtures.hpp"
@@ -72,7 +73,7 @@ struct Agreement {
 // joint that is not an End Site, every frame.
 Agreement compare(const motion::Clip& clip, const BlenderImport& b) {
   Agreement a;
-  std::vector<motion::JointPose> poses;
+  std::vector<std::pair<std::size_t, const std::vector<Eigen::Vector3d>*>> matched;  // joint, Blender's heads
   for (std::size_t j = 0; j < clip.joints.size(); ++j) {
     if (clip.joints[j].end_site) continue;
     const auto it = b.heads.find(clip.joints[j].name);
@@ -80,18 +81,18 @@ Agreement compare(const motion::Clip& clip, const BlenderImport& b) {
       ++a.bones_missing;
       continue;
     }
-    ++a.bones_compared;
+    matched.emplace_back(j, &it->second);
   }
+  a.bones_compared = matched.size();
+  std::vector<motion::JointPose> poses;
   for (std::size_t f = 0; f < clip.frame_count; ++f) {
     if (!motion::forward_kinematics(clip, f, poses)) {
       a.max_error = std::numeric_limits<double>::infinity();
       a.worst = "no forward kinematics at frame " + std::to_string(f);
       break;
     }
-    for (std::size_t j = 0; j < clip.joints.size(); ++j) {
-      const auto it = b.heads.find(clip.joints[j].name);
-      if (clip.joints[j].end_site || it == b.heads.end() || it->second.size() != clip.frame_count) continue;
-      const double e = (it->second[f] - poses[j].position).norm();
+    for (const auto& [j, heads] : matched) {
+      const double e = ((*heads)[f] - poses[j].position).norm();
       if (e > a.max_error) {
         a.max_error = e;
         a.worst = clip.joints[j].name + " at frame " + std::to_string(f);

@@ -126,10 +126,8 @@ TEST_CASE("contacts against Zeni's kinematic heel strikes: both detectors land a
   // 2026-12-05: 12 strikes on the Bandai walk (30 Hz), the tool's landing 56
   // ms after Zeni's (mean; 1-2 frames each), the independent estimator's 117
   // ms (3-4 frames); 5 on the CMU walk (120 Hz), 57 and 68 ms.
-  const LandingLags bandai =
-      landing_lags(std::string(TONUS_SHARED_DATA_DIR) + "/bvh/dataset-1_walk_normal_001.bvh", indep::kCentimetre_m);
-  const LandingLags cmu =
-      landing_lags(std::string(TONUS_SOURCE_DIR) + "/tests/data/cmu_02_walk.bvh", indep::kCmuUnit_m);
+  const LandingLags bandai = landing_lags(test::shared_clip("dataset-1_walk_normal_001.bvh"), indep::kCentimetre_m);
+  const LandingLags cmu = landing_lags(test::bundled_clip("cmu_02_walk.bvh"), indep::kCmuUnit_m);
   MESSAGE("landing after Zeni's heel strike, mean: Bandai walk ("
           << bandai.tool_s.size() << " strikes) tool " << 1000 * LandingLags::mean(bandai.tool_s) << " ms, independent "
           << 1000 * LandingLags::mean(bandai.independent_s) << " ms; CMU walk (" << cmu.tool_s.size()
@@ -151,13 +149,11 @@ TEST_CASE("contacts against the independent estimator's: the points agree, the C
   // higher than its resting height, the CMU walk agreed on 86.2 % of
   // point-frames (the independent detector follows the floor with a 1 s
   // window, the tool with 3 s); after, 91.0 %. The others moved by under a point.
-  const std::string shared = std::string(TONUS_SHARED_DATA_DIR) + "/bvh/";
-  const double cmu_walk =
-      point_agreement(std::string(TONUS_SOURCE_DIR) + "/tests/data/cmu_02_walk.bvh", indep::kCmuUnit_m);
-  const double jumps = point_agreement(shared + "cmu_01_01_jumps.bvh", indep::kCmuUnit_m);
-  const double bandai_walk = point_agreement(shared + "dataset-1_walk_normal_001.bvh", indep::kCentimetre_m);
-  const double kicks = point_agreement(shared + "dataset-1_kick_normal_001.bvh", indep::kCentimetre_m);
-  const double punches = point_agreement(shared + "dataset-1_punch_normal_001.bvh", indep::kCentimetre_m);
+  const double cmu_walk = point_agreement(test::bundled_clip("cmu_02_walk.bvh"), indep::kCmuUnit_m);
+  const double jumps = point_agreement(test::shared_clip("cmu_01_01_jumps.bvh"), indep::kCmuUnit_m);
+  const double bandai_walk = point_agreement(test::shared_clip("dataset-1_walk_normal_001.bvh"), indep::kCentimetre_m);
+  const double kicks = point_agreement(test::shared_clip("dataset-1_kick_normal_001.bvh"), indep::kCentimetre_m);
+  const double punches = point_agreement(test::shared_clip("dataset-1_punch_normal_001.bvh"), indep::kCentimetre_m);
   MESSAGE("point-frames agreeing: CMU walk " << 100 * cmu_walk << " %, jumps " << 100 * jumps << " %, Bandai walk "
                                              << 100 * bandai_walk << " %, kicks " << 100 * kicks << " %, punches "
                                              << 100 * punches << " %");
